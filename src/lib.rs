@@ -1,0 +1,34 @@
+//! # shapecorr
+//!
+//! Region-level correspondences between 3D shapes (triangle meshes and point clouds), after
+//! Kleiman and Ovsjanikov, "Robust Structure-based Shape Correspondence".
+//!
+//! The modules follow the data flow: [`io`] (files) -> [`shape`] (validated shape) ->
+//! [`laplacian`] -> [`eigen`] (eigenbasis) -> [`descriptors`] (HKS, WKS). [`synth`] makes
+//! articulated test figures with known ground truth; [`progress`] carries progress reports
+//! and cancellation.
+//!
+//! Every per-vertex output is indexed by the caller's input vertices. Direction lives in the
+//! name: `p2p_21[i]` is the vertex of shape 1 matched to vertex `i` of shape 2; `fmap_12`
+//! maps functions on shape 1 to functions on shape 2.
+
+// `!(x > 0.0)` is the NaN-rejecting comparison this numerical code means; clippy's rewrite
+// with `partial_cmp` would hide that.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod descriptors;
+pub mod eigen;
+pub mod error;
+pub mod io;
+pub mod laplacian;
+pub mod neighbors;
+pub mod progress;
+pub mod shape;
+pub mod synth;
+
+pub use descriptors::{hks, wks, HksParams, WksParams};
+pub use eigen::{EigenParams, Eigenbasis};
+pub use error::{Error, Result};
+pub use laplacian::Laplacian;
+pub use progress::{NoProgress, Progress, Stage};
+pub use shape::{Shape, ShapeKind, Warning};

@@ -1,0 +1,541 @@
+//! The validated input shape: a triangle mesh or a point cloud.
+//!
+//! Validation happens once, here, at the boundary. Fatal problems (non-finite coordinates,
+//! face indices out of range, too few vertices, zero area) are typed [`Error`]s; problems the
+//! pipeline can live with (degenerate or duplicate faces, unreferenced vertices, several
+//! connected pieces, non-manifold edges, inconsistent orientation, polygons) are repaired or
+//! ignored and reported as [`Warning`]s. The caller's vertex order is kept exactly: every
+//! per-vertex output of the library is indexed by the input vertices.
+
+use std::collections::HashMap;
+
+use crate::io::RawShape;
+use crate::neighbors::{symmetric_knn_graph, PointTree};
+use crate::{Error, Result};
+
+/// Fewest usable vertices the pipeline accepts. The point-cloud Laplacian looks at
+/// [`crate::laplacian::POINT_CLOUD_NEIGHBORS`] neighbours of every point and the
+/// descriptors need a spectrum of some length, so anything smaller is rejected.
+pub const MIN_VERTICES: usize = 32;
+
+/// Neighbours per point in the point-cloud connectivity graph (paper, section 6.3: k = 6).
+pub const POINT_CLOUD_GRAPH_K: usize = 6;
+
+/// Whether a shape is a triangle mesh or a point cloud.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    Mesh,
+    PointCloud,
+}
+
+/// Something in the input that was repaired or ignored rather than rejected.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Warning {
+    /// Faces with a repeated corner (zero area by construction) were dropped.
+    DegenerateFacesDropped { count: usize },
+    /// Faces with the same three corners as an earlier face were dropped.
+    DuplicateFacesDropped { count: usize },
+    /// Polygons with more than three corners were split into triangles.
+    PolygonsTriangulated { count: usize },
+    /// Vertices used by no face; they take the values of the nearest used vertex.
+    UnreferencedVertices { count: usize },
+    /// The surface (or the point cloud's neighbour graph) has several connected pieces.
+    DisconnectedPieces { count: usize },
+    /// Edges shared by more than two faces (the Laplacian handles them).
+    NonManifoldEdges { count: usize },
+    /// Neighbouring faces with opposite orientation (the Laplacian does not depend on it).
+    InconsistentOrientation { edges: usize },
+    /// Faces with (near) zero area but distinct corners; the Laplacian mollifies them.
+    NeedleOrZeroAreaFaces { count: usize },
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Warning::DegenerateFacesDropped { count } => {
+                write!(f, "{count} degenerate faces (repeated corner) dropped")
+            }
+            Warning::DuplicateFacesDropped { count } => {
+                write!(f, "{count} duplicate faces dropped")
+            }
+            Warning::PolygonsTriangulated { count } => {
+                write!(f, "{count} polygons with more than 3 corners triangulated")
+            }
+            Warning::UnreferencedVertices { count } => write!(
+                f,
+                "{count} vertices are used by no face; they take the values of the nearest used vertex"
+            ),
+            Warning::DisconnectedPieces { count } => {
+                write!(f, "the shape has {count} disconnected pieces")
+            }
+            Warning::NonManifoldEdges { count } => {
+                write!(f, "{count} non-manifold edges (shared by more than two faces)")
+            }
+            Warning::InconsistentOrientation { edges } => write!(
+                f,
+                "{edges} edges join faces of opposite orientation (harmless for the Laplacian)"
+            ),
+            Warning::NeedleOrZeroAreaFaces { count } => write!(
+                f,
+                "{count} faces have (near) zero area; the Laplacian mollifies them"
+            ),
+        }
+    }
+}
+
+/// A validated triangle mesh or point cloud, in the caller's vertex order.
+#[derive(Debug, Clone)]
+pub struct Shape {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    kind: ShapeKind,
+    /// Input vertices the computation runs on (all of them for a point cloud; those used by
+    /// a face for a mesh), ascending.
+    active: Vec<u32>,
+    /// For every input vertex, the active vertex whose values it takes (itself if active).
+    representative: Vec<u32>,
+    n_pieces: usize,
+    warnings: Vec<Warning>,
+}
+
+impl Shape {
+    /// A triangle mesh. Faces are validated and cleaned; see the module docs.
+    pub fn mesh(vertices: Vec<[f64; 3]>, triangles: &[[u32; 3]]) -> Result<Shape> {
+        let polygons: Vec<&[u32]> = triangles.iter().map(|t| t.as_slice()).collect();
+        Shape::build(vertices, &polygons, ShapeKind::Mesh)
+    }
+
+    /// A mesh from polygons of any size (quads and n-gons are triangulated).
+    pub fn mesh_from_polygons(vertices: Vec<[f64; 3]>, polygons: &[Vec<u32>]) -> Result<Shape> {
+        let polygons: Vec<&[u32]> = polygons.iter().map(|p| p.as_slice()).collect();
+        Shape::build(vertices, &polygons, ShapeKind::Mesh)
+    }
+
+    /// A point cloud (no faces).
+    pub fn point_cloud(vertices: Vec<[f64; 3]>) -> Result<Shape> {
+        Shape::build(vertices, &[], ShapeKind::PointCloud)
+    }
+
+    /// A shape from a file's contents: a point cloud when it has no faces or when
+    /// `as_point_cloud` is set, a mesh otherwise.
+    pub fn from_raw(raw: RawShape, as_point_cloud: bool) -> Result<Shape> {
+        if as_point_cloud || raw.polygons.is_empty() {
+            Shape::point_cloud(raw.vertices)
+        } else {
+            Shape::mesh_from_polygons(raw.vertices, &raw.polygons)
+        }
+    }
+
+    /// Reads a file (OFF, OBJ, PLY, XYZ/PTS) into a shape.
+    pub fn read(path: &std::path::Path, as_point_cloud: bool) -> Result<Shape> {
+        Shape::from_raw(crate::io::read_shape(path)?, as_point_cloud)
+    }
+
+    fn build(vertices: Vec<[f64; 3]>, polygons: &[&[u32]], kind: ShapeKind) -> Result<Shape> {
+        for (i, v) in vertices.iter().enumerate() {
+            if let Some(&value) = v.iter().find(|c| !c.is_finite()) {
+                return Err(Error::NonFiniteCoordinate { vertex: i, value });
+            }
+        }
+        let n = vertices.len();
+        if n < MIN_VERTICES {
+            return Err(Error::TooFewVertices {
+                received: n,
+                required: MIN_VERTICES,
+            });
+        }
+        let mut warnings = Vec::new();
+        let (triangles, active) = match kind {
+            ShapeKind::Mesh => {
+                let triangles = clean_faces(&vertices, polygons, &mut warnings)?;
+                if triangles.is_empty() {
+                    return Err(Error::ZeroArea {
+                        detail: if polygons.is_empty() {
+                            "the mesh has no faces; read vertices without faces as a point cloud"
+                                .to_string()
+                        } else {
+                            format!("all {} faces repeat a corner", polygons.len())
+                        },
+                    });
+                }
+                let mut used = vec![false; n];
+                for t in &triangles {
+                    for &v in t {
+                        used[v as usize] = true;
+                    }
+                }
+                let active: Vec<u32> = (0..n as u32).filter(|&v| used[v as usize]).collect();
+                (triangles, active)
+            }
+            ShapeKind::PointCloud => (Vec::new(), (0..n as u32).collect()),
+        };
+        if active.len() < MIN_VERTICES {
+            return Err(Error::TooFewVertices {
+                received: active.len(),
+                required: MIN_VERTICES,
+            });
+        }
+        let representative = representatives(&vertices, &active);
+        if active.len() < n {
+            warnings.push(Warning::UnreferencedVertices {
+                count: n - active.len(),
+            });
+        }
+        let mut shape = Shape {
+            vertices,
+            triangles,
+            kind,
+            active,
+            representative,
+            n_pieces: 0,
+            warnings,
+        };
+        match kind {
+            ShapeKind::Mesh => {
+                let area = shape.mesh_area();
+                if !(area > 0.0) {
+                    return Err(Error::ZeroArea {
+                        detail: format!("{} faces, all of zero area", shape.triangles.len()),
+                    });
+                }
+                let needles = shape.count_needle_faces(area);
+                if needles > 0 {
+                    shape
+                        .warnings
+                        .push(Warning::NeedleOrZeroAreaFaces { count: needles });
+                }
+                shape.check_edges();
+            }
+            ShapeKind::PointCloud => {
+                let extent = bounding_box_diagonal(&shape.vertices);
+                if !(extent > 0.0) {
+                    return Err(Error::ZeroArea {
+                        detail: format!("all {} points coincide", shape.vertices.len()),
+                    });
+                }
+            }
+        }
+        shape.n_pieces = shape.count_pieces();
+        if shape.n_pieces > 1 {
+            shape.warnings.push(Warning::DisconnectedPieces {
+                count: shape.n_pieces,
+            });
+        }
+        Ok(shape)
+    }
+
+    /// Vertex positions in the caller's order and units.
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
+    }
+
+    /// The cleaned triangles (empty for a point cloud), indexing [`Shape::vertices`].
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Mesh or point cloud.
+    pub fn kind(&self) -> ShapeKind {
+        self.kind
+    }
+
+    /// Number of input vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.vertices.len()
+    }
+
+    /// Input vertices the computation runs on, ascending (unreferenced mesh vertices are
+    /// left out).
+    pub fn active_vertices(&self) -> &[u32] {
+        &self.active
+    }
+
+    /// For every input vertex, the active vertex whose values it takes (itself if active).
+    pub fn representative(&self) -> &[u32] {
+        &self.representative
+    }
+
+    /// Number of connected pieces (of the surface, or of the point cloud's kNN graph).
+    pub fn n_pieces(&self) -> usize {
+        self.n_pieces
+    }
+
+    /// What was repaired or ignored while building the shape.
+    pub fn warnings(&self) -> &[Warning] {
+        &self.warnings
+    }
+
+    /// Total surface area of a mesh in the input units (0 for a point cloud: its area is
+    /// estimated by the Laplacian's mass, [`crate::laplacian::Laplacian::input_area`]).
+    pub fn mesh_area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| triangle_area(&self.vertices, t))
+            .sum()
+    }
+
+    /// Length of the bounding-box diagonal, the "width" of the shape.
+    pub fn width(&self) -> f64 {
+        bounding_box_diagonal(&self.vertices)
+    }
+
+    /// Undirected edges between active vertices, each once as (low, high), sorted: mesh edges,
+    /// or the symmetric k-nearest-neighbour graph (k = [`POINT_CLOUD_GRAPH_K`]) of a point cloud.
+    pub fn edges(&self) -> Vec<(u32, u32)> {
+        let mut edges: Vec<(u32, u32)> = match self.kind {
+            ShapeKind::Mesh => self
+                .triangles
+                .iter()
+                .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+                .map(|(a, b)| (a.min(b), a.max(b)))
+                .collect(),
+            ShapeKind::PointCloud => symmetric_knn_graph(&self.vertices, POINT_CLOUD_GRAPH_K)
+                .into_iter()
+                .enumerate()
+                .flat_map(|(i, list)| {
+                    list.into_iter()
+                        .filter(move |&j| j > i)
+                        .map(move |j| (i as u32, j as u32))
+                })
+                .collect(),
+        };
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
+    /// A copy of the shape with moved vertices (same faces), e.g. after a rigid motion.
+    pub fn with_vertices(&self, vertices: Vec<[f64; 3]>) -> Result<Shape> {
+        match self.kind {
+            ShapeKind::Mesh => Shape::mesh(vertices, &self.triangles),
+            ShapeKind::PointCloud => Shape::point_cloud(vertices),
+        }
+    }
+
+    fn count_needle_faces(&self, total_area: f64) -> usize {
+        let mean = total_area / self.triangles.len() as f64;
+        self.triangles
+            .iter()
+            .filter(|t| triangle_area(&self.vertices, t) < NEEDLE_AREA_FRACTION * mean)
+            .count()
+    }
+
+    /// Counts non-manifold edges and orientation conflicts and records them as warnings.
+    fn check_edges(&mut self) {
+        // For every undirected edge: number of faces using it, and how many of them run it
+        // from low to high.
+        let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let entry = uses.entry((a.min(b), a.max(b))).or_insert((0, 0));
+                entry.0 += 1;
+                if a < b {
+                    entry.1 += 1;
+                }
+            }
+        }
+        let non_manifold = uses.values().filter(|(n, _)| *n > 2).count();
+        let flipped = uses
+            .values()
+            .filter(|(n, forward)| *n == 2 && *forward != 1)
+            .count();
+        if non_manifold > 0 {
+            self.warnings.push(Warning::NonManifoldEdges {
+                count: non_manifold,
+            });
+        }
+        if flipped > 0 {
+            self.warnings
+                .push(Warning::InconsistentOrientation { edges: flipped });
+        }
+    }
+
+    fn count_pieces(&self) -> usize {
+        let mut sets = DisjointSets::new(self.vertices.len());
+        for (a, b) in self.edges() {
+            sets.union(a as usize, b as usize);
+        }
+        let mut roots: Vec<usize> = self.active.iter().map(|&v| sets.find(v as usize)).collect();
+        roots.sort_unstable();
+        roots.dedup();
+        roots.len()
+    }
+}
+
+/// A face whose area is below this fraction of the mean face area counts as a needle.
+const NEEDLE_AREA_FRACTION: f64 = 1e-8;
+
+/// Checks indices, triangulates polygons, drops faces with repeated corners and duplicates.
+fn clean_faces(
+    vertices: &[[f64; 3]],
+    polygons: &[&[u32]],
+    warnings: &mut Vec<Warning>,
+) -> Result<Vec<[u32; 3]>> {
+    let n = vertices.len();
+    let mut triangles = Vec::with_capacity(polygons.len());
+    let mut n_polygons = 0;
+    for (face, polygon) in polygons.iter().enumerate() {
+        if polygon.len() < 3 {
+            return Err(Error::FaceTooSmall {
+                face,
+                corners: polygon.len(),
+            });
+        }
+        if let Some(&index) = polygon.iter().find(|&&i| i as usize >= n) {
+            return Err(Error::FaceIndexOutOfRange {
+                face,
+                index: index as u64,
+                n_vertices: n,
+            });
+        }
+        if polygon.len() > 3 {
+            n_polygons += 1;
+        }
+        triangulate(vertices, polygon, &mut triangles);
+    }
+    if n_polygons > 0 {
+        warnings.push(Warning::PolygonsTriangulated { count: n_polygons });
+    }
+    let before = triangles.len();
+    triangles.retain(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
+    if triangles.len() < before {
+        warnings.push(Warning::DegenerateFacesDropped {
+            count: before - triangles.len(),
+        });
+    }
+    let mut seen = std::collections::HashSet::with_capacity(triangles.len());
+    let before = triangles.len();
+    triangles.retain(|t| {
+        let mut key = *t;
+        key.sort_unstable();
+        seen.insert(key)
+    });
+    if triangles.len() < before {
+        warnings.push(Warning::DuplicateFacesDropped {
+            count: before - triangles.len(),
+        });
+    }
+    Ok(triangles)
+}
+
+/// Splits a polygon into triangles: a quad along its shorter diagonal, larger polygons as
+/// a fan from the first corner (exact for convex polygons).
+fn triangulate(vertices: &[[f64; 3]], polygon: &[u32], out: &mut Vec<[u32; 3]>) {
+    match *polygon {
+        [a, b, c] => out.push([a, b, c]),
+        [a, b, c, d] => {
+            let ac = distance(&vertices[a as usize], &vertices[c as usize]);
+            let bd = distance(&vertices[b as usize], &vertices[d as usize]);
+            if ac <= bd {
+                out.extend([[a, b, c], [a, c, d]]);
+            } else {
+                out.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+        _ => {
+            for k in 1..polygon.len() - 1 {
+                out.push([polygon[0], polygon[k], polygon[k + 1]]);
+            }
+        }
+    }
+}
+
+/// For every vertex, itself if active, else the nearest active vertex.
+fn representatives(vertices: &[[f64; 3]], active: &[u32]) -> Vec<u32> {
+    let mut representative: Vec<u32> = (0..vertices.len() as u32).collect();
+    if active.len() == vertices.len() {
+        return representative;
+    }
+    let active_points: Vec<[f64; 3]> = active.iter().map(|&v| vertices[v as usize]).collect();
+    let tree = PointTree::new(&active_points);
+    let mut is_active = vec![false; vertices.len()];
+    for &v in active {
+        is_active[v as usize] = true;
+    }
+    for (v, rep) in representative.iter_mut().enumerate() {
+        if !is_active[v] {
+            *rep = active[tree.nearest(&vertices[v])];
+        }
+    }
+    representative
+}
+
+/// Area of triangle `t`.
+pub fn triangle_area(vertices: &[[f64; 3]], t: &[u32; 3]) -> f64 {
+    let [a, b, c] = t.map(|i| vertices[i as usize]);
+    let u = sub(&b, &a);
+    let v = sub(&c, &a);
+    0.5 * norm(&cross(&u, &v))
+}
+
+/// Length of the axis-aligned bounding box's diagonal.
+pub fn bounding_box_diagonal(points: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if points.is_empty() {
+        return 0.0;
+    }
+    distance(&lo, &hi)
+}
+
+pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(crate) fn norm(a: &[f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    norm(&sub(a, b))
+}
+
+/// Union-find with path halving, for connected pieces.
+pub(crate) struct DisjointSets {
+    parent: Vec<usize>,
+}
+
+impl DisjointSets {
+    pub(crate) fn new(n: usize) -> Self {
+        DisjointSets {
+            parent: (0..n).collect(),
+        }
+    }
+
+    pub(crate) fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+
+    pub(crate) fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // Smaller root wins, so the result does not depend on the order of unions.
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.parent[hi] = lo;
+        }
+    }
+}

@@ -1,0 +1,148 @@
+//! The command-line tool end to end: real processes, real files.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn shapecorr(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_shapecorr"))
+        .args(args)
+        .output()
+        .expect("the shapecorr binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("shapecorr-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn synth_info_and_eigen_work_together() {
+    let dir = scratch("pipeline");
+    let mesh = dir.join("h.ply");
+    let out = shapecorr(&[
+        "synth",
+        "--kind",
+        "humanoid",
+        "--pose",
+        "2",
+        "--vertices",
+        "3000",
+        "--out",
+        mesh.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let out = shapecorr(&["info", mesh.to_str().unwrap(), "--json"]);
+    assert!(out.status.success());
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let n = info["n_vertices"].as_u64().unwrap();
+    assert!((2500..=3500).contains(&n), "{n} vertices");
+    assert_eq!(info["n_pieces"], 1);
+    assert_eq!(info["kind"], "mesh");
+
+    let export = dir.join("export");
+    let out = shapecorr(&[
+        "eigen",
+        mesh.to_str().unwrap(),
+        "--k",
+        "20",
+        "--json",
+        "--export",
+        export.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let eigen: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let values: Vec<f64> = eigen["eigenvalues"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(values.len(), 20);
+    assert!(values[0].abs() < 1e-8 && values.windows(2).all(|w| w[0] <= w[1]));
+    assert!(eigen["peak_memory_mib"].as_f64().unwrap() > 0.0);
+    for file in ["L.mtx", "M.mtx", "eigenvalues.txt", "eigenvectors.f64"] {
+        assert!(export.join(file).exists(), "{file} exported");
+    }
+    let raw = std::fs::read(export.join("eigenvectors.f64")).unwrap();
+    assert_eq!(raw.len() as u64, 8 * 20 * n);
+
+    // A point cloud of the same figure, with its ground truth.
+    let cloud = dir.join("c.ply");
+    let out = shapecorr(&[
+        "synth",
+        "--kind",
+        "star5",
+        "--vertices",
+        "2000",
+        "--points",
+        "1500",
+        "--noise",
+        "0.01",
+        "--out",
+        cloud.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = shapecorr(&["info", cloud.to_str().unwrap(), "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["kind"], "point_cloud");
+    assert_eq!(info["n_vertices"], 1500);
+    let gt = std::fs::read_to_string(cloud.with_extension("gt.txt")).unwrap();
+    assert_eq!(gt.lines().count(), 1500);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_input_exits_non_zero_with_a_one_line_reason() {
+    let dir = scratch("bad");
+    let nan = dir.join("nan.off");
+    let mut text = String::from("OFF\n40 1 0\n");
+    for i in 0..40 {
+        text.push_str(if i == 7 { "nan 0 0\n" } else { "0 1 2\n" });
+    }
+    text.push_str("3 0 1 2\n");
+    std::fs::write(&nan, text).unwrap();
+    let truncated = dir.join("cut.ply");
+    std::fs::write(&truncated, b"ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n").unwrap();
+    let cases: Vec<Vec<String>> = vec![
+        vec!["info".into(), nan.display().to_string()],
+        vec!["eigen".into(), truncated.display().to_string()],
+        vec!["info".into(), dir.join("missing.obj").display().to_string()],
+        vec![
+            "synth".into(),
+            "--kind".into(),
+            "octopus".into(),
+            "--out".into(),
+            dir.join("x.ply").display().to_string(),
+        ],
+        vec![
+            "synth".into(),
+            "--kind".into(),
+            "star12".into(),
+            "--out".into(),
+            dir.join("x.ply").display().to_string(),
+        ],
+    ];
+    for args in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = shapecorr(&args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.starts_with("shapecorr: "), "{args:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
