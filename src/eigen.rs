@@ -56,7 +56,7 @@ impl Default for EigenParams {
             n_eigenpairs: 100,
             shift: 1.0,
             tolerance: 1e-13,
-            block_size: 8,
+            block_size: 4,
             seed: 0x5eed,
             threads: 0,
         }
@@ -336,10 +336,12 @@ fn block_lanczos(
     basis.as_mut().subcols_mut(0, b).copy_from(&q);
 
     let mut w = Mat::<f64>::zeros(n, b);
-    // Convergence is checked (a dense eigensolve of the projection) from 2k vectors on, then
-    // after every further k/4 or so.
+    // Convergence is checked (a dense eigensolve of the projection) from 2k vectors on. After
+    // a failed check the next one is placed where the worst residual, decaying geometrically
+    // since the previous check, should meet the tolerance (at most k/4 vectors later).
     let check_every = (k / 4).div_ceil(b).max(1) * b;
     let mut next_check = 2 * k;
+    let mut previous: Option<(usize, f64)> = None;
     for block in 0..max_blocks {
         let m = (block + 1) * b;
         check(
@@ -361,11 +363,23 @@ fn block_lanczos(
         basis.as_mut().subcols_mut(m, b).copy_from(&q);
 
         if m >= next_check || block + 1 == max_blocks {
-            next_check = m + check_every;
-            let ritz = rayleigh_ritz(&basis, &projected, m, b, k, params, laplacian, par)?;
-            if let Some(result) = ritz {
-                check(progress, Stage::Eigenbasis, 1.0)?;
-                return Ok(result);
+            match rayleigh_ritz(&basis, &projected, m, b, k, params, laplacian, par)? {
+                Ritz::Converged(result) => {
+                    check(progress, Stage::Eigenbasis, 1.0)?;
+                    return Ok(result);
+                }
+                Ritz::NotYet { excess } => {
+                    let mut step = check_every;
+                    if let Some((m_before, excess_before)) = previous {
+                        let rate = (excess_before.ln() - excess.ln()) / (m - m_before) as f64;
+                        if rate > 0.0 {
+                            let needed = (1.1 * excess.ln() / rate).ceil() as usize;
+                            step = needed.div_ceil(b).clamp(1, check_every / b) * b;
+                        }
+                    }
+                    previous = Some((m, excess));
+                    next_check = m + step;
+                }
             }
         }
     }
@@ -377,8 +391,15 @@ fn block_lanczos(
     })
 }
 
-/// Ritz pairs from the first `m` basis vectors; `None` while the `k` largest are not all
-/// converged.
+/// The outcome of a convergence check.
+enum Ritz {
+    /// Eigenvalues ascending and M-orthonormal eigenvectors.
+    Converged((Vec<f64>, Mat<f64>)),
+    /// Largest ratio of a wanted pair's residual to its tolerance (> 1).
+    NotYet { excess: f64 },
+}
+
+/// Ritz pairs from the first `m` basis vectors, once the `k` largest are all converged.
 #[allow(clippy::too_many_arguments)]
 fn rayleigh_ritz(
     basis: &Mat<f64>,
@@ -389,7 +410,7 @@ fn rayleigh_ritz(
     params: &EigenParams,
     laplacian: &Laplacian,
     par: Par,
-) -> Result<Option<(Vec<f64>, Mat<f64>)>> {
+) -> Result<Ritz> {
     let h = projected.as_ref().submatrix(0, 0, m, m);
     let t = Mat::from_fn(m, m, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
     let evd = t
@@ -412,12 +433,19 @@ fn rayleigh_ritz(
         Par::Seq,
     );
     // The largest theta are the last columns (ascending order).
+    let mut excess: f64 = 0.0;
     for idx in (m - k)..m {
         let theta = evd.S()[idx];
-        let r = residual.col(idx).norm_l2();
-        if !(theta > 0.0) || r > params.tolerance * theta {
-            return Ok(None);
+        if !(theta > 0.0) {
+            excess = f64::INFINITY;
+        } else {
+            excess = excess.max(residual.col(idx).norm_l2() / (params.tolerance * theta));
         }
+    }
+    if !(excess <= 1.0) {
+        return Ok(Ritz::NotYet {
+            excess: excess.min(1e300),
+        });
     }
     let mut ritz = Mat::<f64>::zeros(m, k);
     for (out, idx) in (0..k).zip((m - k..m).rev()) {
@@ -432,7 +460,7 @@ fn rayleigh_ritz(
         1.0,
         par,
     );
-    refine_in_original_problem(laplacian, vectors, par).map(Some)
+    refine_in_original_problem(laplacian, vectors, par).map(Ritz::Converged)
 }
 
 /// Rayleigh-Ritz of the pencil `(L, M)` itself on the span of the converged vectors: the
@@ -585,26 +613,83 @@ fn project_out(
     w: &mut Mat<f64>,
     coefficients: &mut Mat<f64>,
     offset: usize,
-    par: Par,
+    _par: Par,
 ) {
     let (m, b) = (v.ncols(), w.ncols());
-    let mw = op.mass_times(w.as_ref());
-    let mut c = Mat::<f64>::zeros(m, b);
-    matmul(
-        c.as_mut(),
-        Accum::Replace,
-        v.transpose(),
-        mw.as_ref(),
-        1.0,
-        par,
-    );
-    matmul(w.as_mut(), Accum::Add, v, c.as_ref(), -1.0, par);
+    let c = transpose_times_mass_times(v, w.as_ref(), &op.mass);
+    subtract_product(w, v, c.as_ref());
     let mut rows = coefficients.as_mut().subrows_mut(offset, m);
     for j in 0..b {
         for i in 0..m {
             rows[(i, j)] += c[(i, j)];
         }
     }
+}
+
+/// Rows per chunk of the tall-skinny products below. The chunking is fixed (it does not
+/// depend on the number of threads), so the sums, and the results, are identical on any
+/// thread count.
+const ROWS_PER_CHUNK: usize = 1024;
+
+/// `V^T M W` for tall `V` (n x m) and skinny `W` (n x b): partial products over fixed row
+/// chunks in parallel, summed in chunk order. faer's matmul runs this shape (a long inner
+/// dimension) on one thread.
+fn transpose_times_mass_times(v: MatRef<'_, f64>, w: MatRef<'_, f64>, mass: &[f64]) -> Mat<f64> {
+    use rayon::prelude::*;
+    let (n, m, b) = (v.nrows(), v.ncols(), w.ncols());
+    let partials: Vec<Mat<f64>> = (0..n.div_ceil(ROWS_PER_CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let start = chunk * ROWS_PER_CHUNK;
+            let rows = ROWS_PER_CHUNK.min(n - start);
+            let mw = Mat::from_fn(rows, b, |i, j| mass[start + i] * w[(start + i, j)]);
+            let mut c = Mat::<f64>::zeros(m, b);
+            matmul(
+                c.as_mut(),
+                Accum::Replace,
+                v.subrows(start, rows).transpose(),
+                mw.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            c
+        })
+        .collect();
+    let mut total = Mat::<f64>::zeros(m, b);
+    for c in &partials {
+        total += c;
+    }
+    total
+}
+
+/// `W -= V C` for tall `V` and `W`, by independent row chunks in parallel.
+fn subtract_product(w: &mut Mat<f64>, v: MatRef<'_, f64>, c: MatRef<'_, f64>) {
+    use rayon::prelude::*;
+    let n = w.nrows();
+    let chunks: Vec<(usize, MatMut<'_, f64>)> = {
+        let mut rest = w.as_mut();
+        let mut out = Vec::new();
+        let mut start = 0;
+        while start < n {
+            let rows = ROWS_PER_CHUNK.min(n - start);
+            let (head, tail) = rest.split_at_row_mut(rows);
+            out.push((start, head));
+            rest = tail;
+            start += rows;
+        }
+        out
+    };
+    chunks.into_par_iter().for_each(|(start, mut chunk)| {
+        let rows = chunk.nrows();
+        matmul(
+            chunk.rb_mut(),
+            Accum::Add,
+            v.subrows(start, rows),
+            c,
+            -1.0,
+            Par::Seq,
+        );
+    });
 }
 
 /// One Cholesky QR step in the M inner product: `G = w^T M w = R^T R`, `w <- w R^{-1}`.

@@ -259,24 +259,28 @@ fn eigenvalues_and_hks_do_not_change_under_permutation_rigid_motion_and_scaling(
 #[test]
 fn eigenbasis_is_identical_on_any_thread_count() {
     let shape = bumpy_sphere();
-    let one = Eigenbasis::compute(
-        &shape,
-        &EigenParams {
-            threads: 1,
-            ..small_params()
-        },
-    )
-    .unwrap();
-    let two = Eigenbasis::compute(
-        &shape,
-        &EigenParams {
-            threads: 2,
-            ..small_params()
-        },
-    )
-    .unwrap();
-    assert_eq!(one.values, two.values);
-    assert!(one.vectors == two.vectors);
+    let compute_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            Eigenbasis::compute(
+                &shape,
+                &EigenParams {
+                    threads,
+                    ..small_params()
+                },
+            )
+            .unwrap()
+        })
+    };
+    let one = compute_on(1);
+    for threads in [2, 3] {
+        let other = compute_on(threads);
+        assert_eq!(one.values, other.values, "{threads} threads");
+        assert!(one.vectors == other.vectors, "{threads} threads");
+    }
 }
 
 #[test]
