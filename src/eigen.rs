@@ -325,8 +325,10 @@ fn block_lanczos(
     // quick (typically 2k-3.5k vectors), the cap only guards against stagnation.
     let max_dim = (6 * k + 20 * b).min(n - b);
     let max_blocks = max_dim / b;
-    let mut basis = Mat::<f64>::zeros(n, (max_blocks + 1) * b);
-    let mut projected = Mat::<f64>::zeros((max_blocks + 1) * b, (max_blocks + 1) * b);
+    // Room for the usual 4k vectors first; grown (copied) only if convergence needs more.
+    let mut capacity = ((4 * k).div_ceil(b) + 1).min(max_blocks + 1) * b;
+    let mut basis = Mat::<f64>::zeros(n, capacity);
+    let mut projected = Mat::<f64>::zeros(capacity, capacity);
     let mut buffer = op.scratch(b)?;
 
     // Random start block, M-orthonormalised.
@@ -344,6 +346,21 @@ fn block_lanczos(
     let mut previous: Option<(usize, f64)> = None;
     for block in 0..max_blocks {
         let m = (block + 1) * b;
+        if m + b > capacity {
+            capacity = (max_blocks + 1) * b;
+            let mut grown = Mat::<f64>::zeros(n, capacity);
+            grown
+                .as_mut()
+                .subcols_mut(0, m)
+                .copy_from(basis.as_ref().subcols(0, m));
+            basis = grown;
+            let mut grown = Mat::<f64>::zeros(capacity, capacity);
+            grown
+                .as_mut()
+                .submatrix_mut(0, 0, m, m)
+                .copy_from(projected.as_ref().submatrix(0, 0, m, m));
+            projected = grown;
+        }
         check(
             progress,
             Stage::Eigenbasis,

@@ -16,14 +16,23 @@
 // with `partial_cmp` would hide that.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bench;
+pub mod correspondence;
+pub mod datasets;
 pub mod descriptors;
 pub mod eigen;
 pub mod error;
+pub mod evaluation;
+pub mod geodesic;
+pub mod graph;
 pub mod io;
 pub mod laplacian;
+pub mod matching;
 pub mod neighbors;
 pub mod progress;
+pub mod segmentation;
 pub mod shape;
+pub mod symmetry;
 pub mod synth;
 
 pub use descriptors::{hks, wks, HksParams, WksParams};

@@ -7,8 +7,12 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use serde_json::json;
+use shapecorr::correspondence::{region_colors, Correspondence, Params, Symmetry};
+use shapecorr::evaluation::score;
+use shapecorr::graph::ShapeGraph;
+use shapecorr::progress::{Progress, Stage};
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
-use shapecorr::{hks, EigenParams, Eigenbasis, Error, HksParams, Laplacian, Shape, ShapeKind};
+use shapecorr::{EigenParams, Eigenbasis, Error, Laplacian, Shape, ShapeKind};
 
 #[derive(Parser)]
 #[command(
@@ -83,16 +87,128 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// The main job for now: two generated figures in different poses, their eigenbases
-    /// and heat kernel signatures, coloured PLYs, and how well the descriptors agree at
-    /// corresponding vertices.
+    /// Region correspondence between two shapes: writes DIR/result.json and
+    /// DIR/a_regions.ply, DIR/b_regions.ply (matched regions share a colour, unmatched ones
+    /// are dark grey).
+    Match {
+        a: PathBuf,
+        b: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// Treat both files as point clouds even if they have faces.
+        #[arg(long)]
+        points: bool,
+        #[command(flatten)]
+        method: MethodArgs,
+    },
+    /// Symmetric regions of one shape (the shape matched to itself): DIR/result.json and a
+    /// PLY coloured by symmetry group.
+    Symmetry {
+        a: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long)]
+        points: bool,
+        #[command(flatten)]
+        method: MethodArgs,
+    },
+    /// Benchmarks on the research datasets.
+    Bench {
+        #[command(subcommand)]
+        which: BenchCommand,
+    },
+    /// The main job: two generated humanoids in different poses, one of them a noisy point
+    /// cloud, matched; coloured PLYs and the region accuracy against the known ground truth.
     Demo {
         /// Output folder.
         #[arg(long, default_value = "out/demo")]
         out: PathBuf,
+        /// Vertices of the mesh (and points of the cloud).
         #[arg(long, default_value_t = 8000)]
         vertices: usize,
     },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Region accuracy over a pair list (like the paper's Table 1).
+    Regions {
+        /// Dataset root (default: $SHAPECORR_DATA or ../shared/data).
+        #[arg(long)]
+        data: Option<PathBuf>,
+        /// Pair list (faust.txt, tosca.txt or tosca_r.txt; the layout follows the name).
+        #[arg(long)]
+        pairs: PathBuf,
+        /// Only the first N pairs.
+        #[arg(long)]
+        limit: Option<usize>,
+        #[command(flatten)]
+        method: MethodArgs,
+    },
+}
+
+/// The main parameters of the method; defaults come from `Params::default()`.
+#[derive(clap::Args, Clone, Default)]
+struct MethodArgs {
+    /// Smallest number of joint clusters tried.
+    #[arg(long)]
+    k_min: Option<usize>,
+    /// Largest number of joint clusters tried.
+    #[arg(long)]
+    k_max: Option<usize>,
+    /// Number of HKS times.
+    #[arg(long)]
+    hks_times: Option<usize>,
+    /// Smallest HKS time (unit-area shape).
+    #[arg(long)]
+    hks_t_min: Option<f64>,
+    /// Largest HKS time (unit-area shape).
+    #[arg(long)]
+    hks_t_max: Option<f64>,
+    /// Gap ratio of the discretisation (a score below ratio x previous ends the matches).
+    #[arg(long)]
+    gap: Option<f64>,
+    /// Largest symmetry order (matches per region).
+    #[arg(long)]
+    max_order: Option<usize>,
+    /// Skip the one-to-one step.
+    #[arg(long)]
+    no_one_to_one: bool,
+    /// Number of eigenpairs.
+    #[arg(long)]
+    eigenpairs: Option<usize>,
+}
+
+impl MethodArgs {
+    fn params(&self) -> Params {
+        let mut p = Params::default();
+        if let Some(v) = self.k_min {
+            p.segmentation.k_min = v;
+        }
+        if let Some(v) = self.k_max {
+            p.segmentation.k_max = v;
+        }
+        if let Some(v) = self.hks_times {
+            p.hks.n_times = v;
+        }
+        if let Some(v) = self.hks_t_min {
+            p.hks.t_min = v;
+        }
+        if let Some(v) = self.hks_t_max {
+            p.hks.t_max = v;
+        }
+        if let Some(v) = self.gap {
+            p.matching.gap_ratio = v;
+        }
+        if let Some(v) = self.max_order {
+            p.matching.max_symmetry_order = v;
+        }
+        if let Some(v) = self.eigenpairs {
+            p.eigen.n_eigenpairs = v;
+        }
+        p.skip_one_to_one = self.no_one_to_one;
+        p
+    }
 }
 
 fn main() -> ExitCode {
@@ -130,6 +246,28 @@ fn main() -> ExitCode {
             seed,
             &out,
         ),
+        Command::Match {
+            a,
+            b,
+            out,
+            points,
+            method,
+        } => match_command(&a, &b, &out, points, &method.params()),
+        Command::Symmetry {
+            a,
+            out,
+            points,
+            method,
+        } => symmetry_command(&a, &out, points, &method.params()),
+        Command::Bench {
+            which:
+                BenchCommand::Regions {
+                    data,
+                    pairs,
+                    limit,
+                    method,
+                },
+        } => bench_regions_command(data, &pairs, limit, &method.params()),
         Command::Demo { out, vertices } => demo(&out, vertices),
     };
     match result {
@@ -333,76 +471,294 @@ fn synth_command(
     Ok(())
 }
 
-fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
+/// Prints stage progress on one line of the terminal (nothing when stderr is not one).
+struct TerminalProgress;
+
+impl Progress for TerminalProgress {
+    fn report(&mut self, stage: Stage, fraction: f32) -> bool {
+        use std::io::{IsTerminal, Write};
+        let mut stderr = std::io::stderr();
+        if stderr.is_terminal() {
+            let _ = write!(
+                stderr,
+                "\r{:<16} {:>3.0}%",
+                format!("{stage:?}"),
+                100.0 * fraction
+            );
+            let _ = stderr.flush();
+        }
+        true
+    }
+}
+
+/// Ends the progress line, if one was drawn.
+fn end_progress_line() {
+    use std::io::IsTerminal;
+    if std::io::stderr().is_terminal() {
+        eprintln!();
+    }
+}
+
+fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), Error> {
+    let text = serde_json::to_string_pretty(value).unwrap_or_default();
+    std::fs::write(path, text).map_err(|e| Error::file(path, e.to_string()))
+}
+
+fn graph_json(graph: &ShapeGraph) -> serde_json::Value {
+    json!({
+        "n_nodes": graph.n_nodes(),
+        "node_area": graph.node_area,
+        "node_cluster": graph.node_cluster,
+        "node_descriptor": graph.node_descriptor,
+        "edges": graph.edges,
+    })
+}
+
+fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> serde_json::Value {
+    json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "n_vertices_a": a.n_vertices(),
+        "n_vertices_b": b.n_vertices(),
+        "kind_a": a.kind(),
+        "kind_b": b.kind(),
+        "k": result.k,
+        "regions_a": result.regions_a(),
+        "regions_b": result.regions_b(),
+        "matches": result.matches,
+        "matches_one_to_one": result.matches_one_to_one,
+        "graph_a": graph_json(&result.graph_a),
+        "graph_b": graph_json(&result.graph_b),
+        "timings_s": result.timings,
+        "warnings_a": a.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
+        "warnings_b": b.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
+    })
+}
+
+/// Writes the coloured PLYs of a correspondence; colours by the one-to-one matches when
+/// there are any, else by the symmetric groups.
+fn write_colored(out: &Path, a: &Shape, b: &Shape, result: &Correspondence) -> Result<(), Error> {
+    let pairs = if result.matches_one_to_one.is_empty() {
+        &result.matches
+    } else {
+        &result.matches_one_to_one
+    };
+    let (colors_a, colors_b) = region_colors(
+        result.regions_a(),
+        result.graph_a.n_nodes(),
+        result.regions_b(),
+        result.graph_b.n_nodes(),
+        pairs,
+    );
+    shapecorr::io::write_ply(
+        &out.join("a_regions.ply"),
+        a.vertices(),
+        a.triangles(),
+        Some(&colors_a),
+    )?;
+    shapecorr::io::write_ply(
+        &out.join("b_regions.ply"),
+        b.vertices(),
+        b.triangles(),
+        Some(&colors_b),
+    )
+}
+
+fn match_command(
+    a: &Path,
+    b: &Path,
+    out: &Path,
+    points: bool,
+    params: &Params,
+) -> Result<(), Error> {
+    let shape_a = Shape::read(a, points)?;
+    let shape_b = Shape::read(b, points)?;
     std::fs::create_dir_all(out).map_err(|e| Error::file(out, e.to_string()))?;
-    let params = EigenParams::default();
-    let hks_params = HksParams::default();
-    let mut signatures = Vec::new();
-    for (name, pose) in [("a", 0usize), ("b", 3usize)] {
-        let t0 = Instant::now();
-        let mesh = synth::figure(&FigureSpec {
-            kind: FigureKind::Humanoid,
-            pose,
-            target_vertices: vertices,
-            proportions: Proportions::default(),
-        })?;
-        let t_synth = t0.elapsed().as_secs_f64();
-        let shape = Shape::mesh(mesh.vertices.clone(), &mesh.triangles)?;
-        let t1 = Instant::now();
-        let basis = Eigenbasis::compute(&shape, &params)?;
-        let t_eigen = t1.elapsed().as_secs_f64();
-        let h = hks(&basis, &hks_params)?;
-        let column: Vec<f64> = (0..h.nrows()).map(|v| h[(v, 0)]).collect();
-        let path = out.join(format!("{name}_hks.ply"));
-        shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, Some(&ramp(&column)))?;
-        println!(
-            "shape {name}: humanoid pose {pose}, {} vertices; made in {t_synth:.2} s, {} eigenpairs in {t_eigen:.2} s; HKS coloured -> {}",
-            shape.n_vertices(),
-            basis.len(),
-            path.display()
-        );
-        signatures.push(h);
-    }
-    // Ground truth is the identity: compare the descriptors at the same vertex.
-    let (a, b) = (&signatures[0], &signatures[1]);
-    for t in [0, a.ncols() / 2, a.ncols() - 1] {
-        let x: Vec<f64> = (0..a.nrows()).map(|v| a[(v, t)]).collect();
-        let y: Vec<f64> = (0..b.nrows()).map(|v| b[(v, t)]).collect();
-        println!(
-            "HKS at time {:.3}: correlation between poses at corresponding vertices {:.4}",
-            hks_params.times()[t],
-            correlation(&x, &y)
-        );
-    }
+    let result = Correspondence::compute(&shape_a, &shape_b, params, &mut TerminalProgress);
+    end_progress_line();
+    let result = result?;
+    write_json(
+        &out.join("result.json"),
+        &correspondence_json(&shape_a, &shape_b, &result),
+    )?;
+    write_colored(out, &shape_a, &shape_b, &result)?;
+    println!(
+        "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one; {:.2} s -> {}",
+        result.k,
+        result.graph_a.n_nodes(),
+        result.graph_b.n_nodes(),
+        result.matches.len(),
+        result.matches_one_to_one.len(),
+        result.timings.total,
+        out.display()
+    );
     Ok(())
 }
 
-fn correlation(x: &[f64], y: &[f64]) -> f64 {
-    let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
-    for (a, b) in x.iter().zip(y) {
-        sxy += (a - mx) * (b - my);
-        sxx += (a - mx) * (a - mx);
-        syy += (b - my) * (b - my);
-    }
-    sxy / (sxx * syy).sqrt()
+fn symmetry_command(a: &Path, out: &Path, points: bool, params: &Params) -> Result<(), Error> {
+    let shape = Shape::read(a, points)?;
+    std::fs::create_dir_all(out).map_err(|e| Error::file(out, e.to_string()))?;
+    let symmetry = Symmetry::detect(&shape, params, &mut TerminalProgress);
+    end_progress_line();
+    let symmetry = symmetry?;
+    let n = symmetry.graph.n_nodes();
+    // Colour by group: every region of a group of two or more shares a colour.
+    let pairs: Vec<(u32, u32)> = symmetry
+        .groups
+        .iter()
+        .filter(|g| g.len() > 1)
+        .flat_map(|g| g.iter().map(move |&r| (g[0], r)))
+        .collect();
+    let (colors, _) = region_colors(&symmetry.graph.labels, n, &[], n, &pairs);
+    shapecorr::io::write_ply(
+        &out.join("a_symmetry.ply"),
+        shape.vertices(),
+        shape.triangles(),
+        Some(&colors),
+    )?;
+    write_json(
+        &out.join("result.json"),
+        &json!({
+            "version": env!("CARGO_PKG_VERSION"),
+            "n_vertices_a": shape.n_vertices(),
+            "regions_a": symmetry.graph.labels,
+            "groups": symmetry.groups,
+            "matches": symmetry.matches,
+            "graph_a": graph_json(&symmetry.graph),
+        }),
+    )?;
+    let symmetric_groups = symmetry.groups.iter().filter(|g| g.len() > 1).count();
+    println!(
+        "{} regions, {} groups of symmetric regions -> {}",
+        n,
+        symmetric_groups,
+        out.display()
+    );
+    Ok(())
 }
 
-/// A blue-to-yellow colour ramp over the range of `values`.
-fn ramp(values: &[f64]) -> Vec<[u8; 3]> {
-    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let span = (hi - lo).max(f64::MIN_POSITIVE);
-    values
+fn bench_regions_command(
+    data: Option<PathBuf>,
+    pairs: &Path,
+    limit: Option<usize>,
+    params: &Params,
+) -> Result<(), Error> {
+    let root = data.unwrap_or_else(shapecorr::datasets::default_data_root);
+    let started = Instant::now();
+    let results = shapecorr::bench::bench_regions(&root, pairs, params, limit, &mut |i, n, r| {
+        eprintln!(
+            "[{}/{}] {} -> {} ({}): symmetric {:.3}, one-to-one {:.3}{}, regions {}/{}, coverage {:.3}, k {}, {:.2} s",
+            i + 1,
+            n,
+            r.pair.source,
+            r.pair.target,
+            r.pair.category,
+            r.scores.symmetric,
+            r.scores.one_to_one,
+            r.scores
+                .one_to_one_flip
+                .map_or(String::new(), |f| format!(" (flip ok {f:.3})")),
+            r.scores.n_regions_a,
+            r.scores.n_regions_b,
+            r.scores.coverage,
+            r.k,
+            r.seconds
+        );
+    })?;
+    println!(
+        "shapecorr {} bench regions --pairs {} ({} pairs, {:.0} s wall)",
+        env!("CARGO_PKG_VERSION"),
+        pairs.display(),
+        results.len(),
+        started.elapsed().as_secs_f64()
+    );
+    print!("{}", shapecorr::bench::summary_table(&results));
+    Ok(())
+}
+
+fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
+    std::fs::create_dir_all(out).map_err(|e| Error::file(out, e.to_string()))?;
+    let spec = |pose| FigureSpec {
+        kind: FigureKind::Humanoid,
+        pose,
+        target_vertices: vertices,
+        proportions: Proportions::default(),
+    };
+    let t = Instant::now();
+    let mesh_a = synth::figure(&spec(0))?;
+    let mesh_b = synth::figure(&spec(3))?;
+    let cloud_b = synth::sample_points(&mesh_b, vertices, 0.005, 1)?;
+    println!(
+        "A: humanoid, rest pose, mesh of {} vertices; B: humanoid, pose 3, point cloud of {} points with noise 0.5% of the width ({:.2} s)",
+        mesh_a.vertices.len(),
+        cloud_b.points.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let a = Shape::mesh(mesh_a.vertices.clone(), &mesh_a.triangles)?;
+    let b = Shape::point_cloud(cloud_b.points.clone())?;
+    let params = Params::default();
+    let basis_a = Eigenbasis::compute(&a, &params.eigen)?;
+    let basis_b = Eigenbasis::compute(&b, &params.eigen)?;
+    let result =
+        Correspondence::from_bases(&a, &basis_a, &b, &basis_b, &params, &mut TerminalProgress);
+    end_progress_line();
+    let result = result?;
+    eprintln!();
+    write_json(
+        &out.join("result.json"),
+        &correspondence_json(&a, &b, &result),
+    )?;
+    write_colored(out, &a, &b, &result)?;
+    // Ground truth: every point of B knows the vertex of the mesh it was sampled near, and
+    // the two meshes share their vertex order.
+    let truth: Vec<(u32, u32)> = cloud_b
+        .source_vertex
         .iter()
-        .map(|v| {
-            let t = ((v - lo) / span).clamp(0.0, 1.0);
-            [
-                (255.0 * t) as u8,
-                (60.0 + 160.0 * t) as u8,
-                (200.0 * (1.0 - t) + 40.0) as u8,
-            ]
-        })
-        .collect()
+        .enumerate()
+        .map(|(p, &v)| (v, p as u32))
+        .collect();
+    // The rest pose is left/right symmetric about x = 0: the mirror map of A sends each
+    // vertex to the vertex nearest its reflection, for the flip-tolerant score.
+    let tree = shapecorr::neighbors::PointTree::new(a.vertices());
+    let mirror: Vec<u32> = a
+        .vertices()
+        .iter()
+        .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)
+        .collect();
+    let flipped: Vec<(u32, u32)> = truth
+        .iter()
+        .map(|&(v, p)| (mirror[v as usize], p))
+        .collect();
+    let scores = score(
+        result.regions_a(),
+        result.regions_b(),
+        &basis_a.mass,
+        &basis_b.mass,
+        &result.matches,
+        &result.matches_one_to_one,
+        &truth,
+        Some(&flipped),
+    );
+    println!(
+        "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one ({:.2} s after the eigenbases)",
+        result.k,
+        result.graph_a.n_nodes(),
+        result.graph_b.n_nodes(),
+        result.matches.len(),
+        result.matches_one_to_one.len(),
+        result.timings.total
+    );
+    println!(
+        "region accuracy against the ground truth: symmetric {:.3}, one-to-one {:.3}, one-to-one allowing a left/right flip {:.3} (coverage {:.3}, unmatched {:.3})",
+        scores.symmetric,
+        scores.one_to_one,
+        scores.one_to_one_flip.unwrap_or(f64::NAN),
+        scores.coverage,
+        scores.unmatched
+    );
+    println!(
+        "coloured shapes: {} and {} (open them in MeshLab or Blender)",
+        out.join("a_regions.ply").display(),
+        out.join("b_regions.ply").display()
+    );
+    Ok(())
 }

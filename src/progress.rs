@@ -11,6 +11,12 @@ pub enum Stage {
     Eigenbasis = 2,
     /// Computing descriptors.
     Descriptors = 3,
+    /// Joint segmentation and shape graphs over the range of k.
+    Segmentation = 4,
+    /// Spectral graph matching.
+    Matching = 5,
+    /// Symmetry breaking (one-to-one region correspondence).
+    SymmetryBreaking = 6,
 }
 
 /// Receives progress and may cancel: `report` returns `false` to stop the work, which then

@@ -146,3 +146,103 @@ fn bad_input_exits_non_zero_with_a_one_line_reason() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn match_and_symmetry_write_their_results() {
+    let dir = scratch("match");
+    let a = dir.join("a.ply");
+    let b = dir.join("b.ply");
+    for (path, pose) in [(&a, "0"), (&b, "4")] {
+        let out = shapecorr(&[
+            "synth",
+            "--kind",
+            "humanoid",
+            "--pose",
+            pose,
+            "--vertices",
+            "3000",
+            "--out",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success());
+    }
+    let out_dir = dir.join("result");
+    let out = shapecorr(&[
+        "match",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("result.json")).unwrap())
+            .unwrap();
+    let n_a = result["n_vertices_a"].as_u64().unwrap() as usize;
+    assert_eq!(result["regions_a"].as_array().unwrap().len(), n_a);
+    assert_eq!(
+        result["regions_b"].as_array().unwrap().len(),
+        result["n_vertices_b"].as_u64().unwrap() as usize
+    );
+    assert!(result["k"].as_u64().unwrap() >= 5);
+    assert!(!result["matches"].as_array().unwrap().is_empty());
+    assert!(!result["matches_one_to_one"].as_array().unwrap().is_empty());
+    assert!(result["timings_s"]["total"].as_f64().unwrap() > 0.0);
+    assert_eq!(result["version"], env!("CARGO_PKG_VERSION"));
+    // The coloured shapes read back with one colour per vertex.
+    for name in ["a_regions.ply", "b_regions.ply"] {
+        let raw = shapecorr::io::read_shape(&out_dir.join(name)).unwrap();
+        assert_eq!(
+            raw.vertices.len(),
+            if name.starts_with('a') {
+                n_a
+            } else {
+                raw.vertices.len()
+            }
+        );
+    }
+
+    let sym_dir = dir.join("sym");
+    let out = shapecorr(&[
+        "symmetry",
+        a.to_str().unwrap(),
+        "--out",
+        sym_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let sym: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(sym_dir.join("result.json")).unwrap())
+            .unwrap();
+    let groups = sym["groups"].as_array().unwrap();
+    assert!(
+        groups.iter().any(|g| g.as_array().unwrap().len() >= 2),
+        "some regions pair up"
+    );
+    assert!(sym_dir.join("a_symmetry.ply").exists());
+
+    // Bad input: a missing file, a tiny shape.
+    let out = shapecorr(&[
+        "match",
+        a.to_str().unwrap(),
+        dir.join("missing.ply").to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr)
+            .trim_end()
+            .lines()
+            .count(),
+        1
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,321 @@
+//! The whole region-correspondence pipeline on generated figures with known ground truth.
+
+use shapecorr::correspondence::{Correspondence, Params, Symmetry};
+use shapecorr::evaluation::{score, RegionScores};
+use shapecorr::neighbors::PointTree;
+use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
+use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, Stage};
+
+fn humanoid(pose: usize, vertices: usize, proportions: Proportions) -> FigureMesh {
+    synth::figure(&FigureSpec {
+        kind: FigureKind::Humanoid,
+        pose,
+        target_vertices: vertices,
+        proportions,
+    })
+    .unwrap()
+}
+
+/// Mirror map of a left/right symmetric rest pose (symmetric about x = 0).
+fn mirror_map(rest: &FigureMesh) -> Vec<u32> {
+    let tree = PointTree::new(&rest.vertices);
+    rest.vertices
+        .iter()
+        .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)
+        .collect()
+}
+
+/// Scores of A -> B with ground-truth pairs `(vertex of A, vertex of B)`; the flipped truth
+/// mirrors A's side.
+fn run(
+    a: &Shape,
+    b: &Shape,
+    truth: &[(u32, u32)],
+    mirror_a: &[u32],
+) -> (Correspondence, RegionScores) {
+    let params = Params::default();
+    let basis_a = Eigenbasis::compute(a, &params.eigen).unwrap();
+    let basis_b = Eigenbasis::compute(b, &params.eigen).unwrap();
+    let result =
+        Correspondence::from_bases(a, &basis_a, b, &basis_b, &params, &mut NoProgress).unwrap();
+    let flipped: Vec<(u32, u32)> = truth
+        .iter()
+        .map(|&(x, y)| (mirror_a[x as usize], y))
+        .collect();
+    let scores = score(
+        result.regions_a(),
+        result.regions_b(),
+        &basis_a.mass,
+        &basis_b.mass,
+        &result.matches,
+        &result.matches_one_to_one,
+        truth,
+        Some(&flipped),
+    );
+    println!("{scores:?}, k = {}", result.k);
+    (result, scores)
+}
+
+fn identity(n: usize) -> Vec<(u32, u32)> {
+    (0..n as u32).map(|v| (v, v)).collect()
+}
+
+#[test]
+fn humanoids_in_different_poses_match_region_by_region() {
+    let rest = humanoid(0, 5000, Proportions::default());
+    let mirror = mirror_map(&rest);
+    let a = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
+    for pose in [2, 4] {
+        let posed = humanoid(pose, 5000, Proportions::default());
+        let b = Shape::mesh(posed.vertices, &posed.triangles).unwrap();
+        let (result, s) = run(&a, &b, &identity(a.n_vertices()), &mirror);
+        assert!(
+            result.graph_a.n_nodes() >= 6,
+            "too few regions to mean anything"
+        );
+        assert!(
+            s.symmetric >= 0.95,
+            "pose {pose}: symmetric accuracy {}",
+            s.symmetric
+        );
+        let flip = s.one_to_one_flip.unwrap();
+        assert!(flip >= 0.90, "pose {pose}: one-to-one (flip ok) {flip}");
+    }
+}
+
+#[test]
+fn other_proportions_and_a_noisy_point_cloud_still_match() {
+    let rest = humanoid(0, 5000, Proportions::default());
+    let mirror = mirror_map(&rest);
+    let a = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
+    // B: longer, thinner limbs in another pose, sampled as a noisy point cloud.
+    let other = humanoid(
+        3,
+        5000,
+        Proportions {
+            limb_length: 1.15,
+            limb_thickness: 0.85,
+        },
+    );
+    let cloud = synth::sample_points(&other, 5000, 0.005, 7).unwrap();
+    let b = Shape::point_cloud(cloud.points).unwrap();
+    let truth: Vec<(u32, u32)> = cloud
+        .source_vertex
+        .iter()
+        .enumerate()
+        .map(|(p, &v)| (v, p as u32))
+        .collect();
+    let (_, s) = run(&a, &b, &truth, &mirror);
+    assert!(s.symmetric >= 0.85, "symmetric accuracy {}", s.symmetric);
+    let flip = s.one_to_one_flip.unwrap();
+    assert!(flip >= 0.85, "one-to-one (flip ok) {flip}");
+}
+
+#[test]
+fn a_permuted_copy_gives_the_permuted_regions_and_swapping_transposes() {
+    let rest = humanoid(0, 3000, Proportions::default());
+    let posed = humanoid(2, 3000, Proportions::default());
+    let a = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
+    let b = Shape::mesh(posed.vertices.clone(), &posed.triangles).unwrap();
+    let params = Params::default();
+    let ab = Correspondence::compute(&a, &b, &params, &mut NoProgress).unwrap();
+
+    // Permute B's vertices: new vertex i is old vertex perm[i].
+    let n = b.n_vertices();
+    let perm: Vec<usize> = (0..n).map(|i| (i * 7919 + 13) % n).collect();
+    assert!(
+        !n.is_multiple_of(7919),
+        "7919 is prime: coprime to n, so this is a permutation"
+    );
+    let mut inverse = vec![0u32; n];
+    for (new, &old) in perm.iter().enumerate() {
+        inverse[old] = new as u32;
+    }
+    let vertices: Vec<[f64; 3]> = perm.iter().map(|&old| posed.vertices[old]).collect();
+    let triangles: Vec<[u32; 3]> = posed
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| inverse[v as usize]))
+        .collect();
+    let b_permuted = Shape::mesh(vertices, &triangles).unwrap();
+    let ab2 = Correspondence::compute(&a, &b_permuted, &params, &mut NoProgress).unwrap();
+    assert_eq!(ab.k, ab2.k);
+    assert_eq!(ab.regions_a(), ab2.regions_a());
+    // Regions of B compared up to relabelling: map old labels to new labels.
+    let mut relabel = vec![u32::MAX; ab.graph_b.n_nodes()];
+    for (new, &old) in perm.iter().enumerate() {
+        let (l_old, l_new) = (ab.regions_b()[old], ab2.regions_b()[new]);
+        if relabel[l_old as usize] == u32::MAX {
+            relabel[l_old as usize] = l_new;
+        }
+        assert_eq!(
+            relabel[l_old as usize], l_new,
+            "regions differ beyond relabelling"
+        );
+    }
+    let mut mapped: Vec<(u32, u32)> = ab
+        .matches
+        .iter()
+        .map(|&(i, j)| (i, relabel[j as usize]))
+        .collect();
+    mapped.sort_unstable();
+    assert_eq!(mapped, ab2.matches);
+
+    // Swapping A and B transposes the symmetric matches.
+    let ba = Correspondence::compute(&b, &a, &params, &mut NoProgress).unwrap();
+    assert_eq!(ba.regions_a(), ab.regions_b());
+    assert_eq!(ba.regions_b(), ab.regions_a());
+    let mut transposed: Vec<(u32, u32)> = ab.matches.iter().map(|&(i, j)| (j, i)).collect();
+    transposed.sort_unstable();
+    assert_eq!(ba.matches, transposed);
+}
+
+#[test]
+fn symmetry_detection_groups_the_limbs_of_a_star() {
+    let star = synth::figure(&FigureSpec {
+        kind: FigureKind::Star { limbs: 5 },
+        target_vertices: 4000,
+        ..Default::default()
+    })
+    .unwrap();
+    let shape = Shape::mesh(star.vertices.clone(), &star.triangles).unwrap();
+    let symmetry = Symmetry::detect(&shape, &Params::default(), &mut NoProgress).unwrap();
+    // Limb tips: vertices farthest from the centre in each of the 5 directions.
+    let centre = star
+        .vertices
+        .iter()
+        .fold([0.0; 3], |c, p| [c[0] + p[0], c[1] + p[1], c[2] + p[2]]);
+    let n = star.vertices.len() as f64;
+    let centre = [centre[0] / n, centre[1] / n, centre[2] / n];
+    let tip = star
+        .vertices
+        .iter()
+        .enumerate()
+        .max_by(|(_, p), (_, q)| {
+            let d = |v: &[f64; 3]| {
+                (v[0] - centre[0]).powi(2) + (v[1] - centre[1]).powi(2) + (v[2] - centre[2]).powi(2)
+            };
+            d(p).total_cmp(&d(q))
+        })
+        .unwrap()
+        .0;
+    let tip_region = symmetry.graph.labels[tip];
+    let group = symmetry
+        .groups
+        .iter()
+        .find(|g| g.contains(&tip_region))
+        .unwrap();
+    assert_eq!(
+        group.len(),
+        5,
+        "the limb-tip regions form one group of 5: {:?}",
+        symmetry.groups
+    );
+}
+
+#[test]
+fn symmetry_detection_pairs_left_and_right_limbs_of_a_humanoid() {
+    let rest = humanoid(0, 4000, Proportions::default());
+    let shape = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
+    let symmetry = Symmetry::detect(&shape, &Params::default(), &mut NoProgress).unwrap();
+    // The hands: the vertices with the largest and smallest x.
+    let by_x = |sign: f64| {
+        rest.vertices
+            .iter()
+            .enumerate()
+            .max_by(|(_, p), (_, q)| (sign * p[0]).total_cmp(&(sign * q[0])))
+            .unwrap()
+            .0
+    };
+    let (left, right) = (
+        symmetry.graph.labels[by_x(1.0)],
+        symmetry.graph.labels[by_x(-1.0)],
+    );
+    assert_ne!(left, right, "the two hands are different regions");
+    let group = symmetry.groups.iter().find(|g| g.contains(&left)).unwrap();
+    assert!(
+        group.contains(&right),
+        "left and right hands pair up: {:?}",
+        symmetry.groups
+    );
+}
+
+#[test]
+fn cancelling_stops_the_pipeline_promptly() {
+    let rest = humanoid(0, 3000, Proportions::default());
+    let posed = humanoid(1, 3000, Proportions::default());
+    let a = Shape::mesh(rest.vertices, &rest.triangles).unwrap();
+    let b = Shape::mesh(posed.vertices, &posed.triangles).unwrap();
+    for cancel_at in [
+        Stage::Eigenbasis,
+        Stage::Segmentation,
+        Stage::Matching,
+        Stage::SymmetryBreaking,
+    ] {
+        let started = std::time::Instant::now();
+        let mut progress = |stage: Stage, _f: f32| stage != cancel_at;
+        let result = Correspondence::compute(&a, &b, &Params::default(), &mut progress);
+        assert!(
+            matches!(result, Err(Error::Cancelled)),
+            "{cancel_at:?}: {:?}",
+            result.map(|r| r.k)
+        );
+        assert!(started.elapsed().as_secs_f64() < 2.0, "{cancel_at:?}");
+    }
+}
+
+#[test]
+fn identical_results_for_identical_inputs_on_any_thread_count() {
+    let rest = humanoid(0, 3000, Proportions::default());
+    let posed = humanoid(5, 3000, Proportions::default());
+    let a = Shape::mesh(rest.vertices, &rest.triangles).unwrap();
+    let b = Shape::mesh(posed.vertices, &posed.triangles).unwrap();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let params = Params {
+                    eigen: EigenParams {
+                        threads,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                Correspondence::compute(&a, &b, &params, &mut NoProgress).unwrap()
+            })
+    };
+    let one = on(1);
+    let two = on(2);
+    assert_eq!(one.regions_a(), two.regions_a());
+    assert_eq!(one.regions_b(), two.regions_b());
+    assert_eq!(one.matches, two.matches);
+    assert_eq!(one.matches_one_to_one, two.matches_one_to_one);
+}
+
+#[test]
+fn cancelling_inside_the_k_loop_stops_the_segmentation() {
+    let rest = humanoid(0, 3000, Proportions::default());
+    let posed = humanoid(1, 3000, Proportions::default());
+    let a = Shape::mesh(rest.vertices, &rest.triangles).unwrap();
+    let b = Shape::mesh(posed.vertices, &posed.triangles).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let mut reports = Vec::new();
+    let result = pool.install(|| {
+        let mut progress = |stage: Stage, fraction: f32| {
+            if stage == Stage::Segmentation {
+                reports.push(fraction);
+            }
+            !(stage == Stage::Segmentation && fraction > 0.0)
+        };
+        Correspondence::compute(&a, &b, &Params::default(), &mut progress)
+    });
+    assert!(matches!(result, Err(Error::Cancelled)));
+    // Reports at the start and after the first batch of k values; nothing after the cancel.
+    assert_eq!(reports.len(), 3, "{reports:?}");
+    assert!(reports[2] > 0.0 && reports[2] < 1.0);
+}
