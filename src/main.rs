@@ -716,14 +716,8 @@ fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
         .enumerate()
         .map(|(p, &v)| (v, p as u32))
         .collect();
-    // The rest pose is left/right symmetric about x = 0: the mirror map of A sends each
-    // vertex to the vertex nearest its reflection, for the flip-tolerant score.
-    let tree = shapecorr::neighbors::PointTree::new(a.vertices());
-    let mirror: Vec<u32> = a
-        .vertices()
-        .iter()
-        .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)
-        .collect();
+    // The rest pose is left/right symmetric: its mirror map gives the flip-tolerant score.
+    let mirror = synth::mirror_map(&mesh_a);
     let flipped: Vec<(u32, u32)> = truth
         .iter()
         .map(|&(v, p)| (mirror[v as usize], p))

@@ -2,7 +2,6 @@
 
 use shapecorr::correspondence::{Correspondence, Params, Symmetry};
 use shapecorr::evaluation::{score, RegionScores};
-use shapecorr::neighbors::PointTree;
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
 use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, Stage};
 
@@ -14,15 +13,6 @@ fn humanoid(pose: usize, vertices: usize, proportions: Proportions) -> FigureMes
         proportions,
     })
     .unwrap()
-}
-
-/// Mirror map of a left/right symmetric rest pose (symmetric about x = 0).
-fn mirror_map(rest: &FigureMesh) -> Vec<u32> {
-    let tree = PointTree::new(&rest.vertices);
-    rest.vertices
-        .iter()
-        .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)
-        .collect()
 }
 
 /// Scores of A -> B with ground-truth pairs `(vertex of A, vertex of B)`; the flipped truth
@@ -63,7 +53,7 @@ fn identity(n: usize) -> Vec<(u32, u32)> {
 #[test]
 fn humanoids_in_different_poses_match_region_by_region() {
     let rest = humanoid(0, 5000, Proportions::default());
-    let mirror = mirror_map(&rest);
+    let mirror = synth::mirror_map(&rest);
     let a = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
     for pose in [2, 4] {
         let posed = humanoid(pose, 5000, Proportions::default());
@@ -86,7 +76,7 @@ fn humanoids_in_different_poses_match_region_by_region() {
 #[test]
 fn other_proportions_and_a_noisy_point_cloud_still_match() {
     let rest = humanoid(0, 5000, Proportions::default());
-    let mirror = mirror_map(&rest);
+    let mirror = synth::mirror_map(&rest);
     let a = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
     // B: longer, thinner limbs in another pose, sampled as a noisy point cloud.
     let other = humanoid(

@@ -331,3 +331,15 @@ fn finish(
 
 #[cfg(test)]
 mod tests;
+
+/// Left/right mirror map of a figure that is symmetric about the plane x = 0 (the rest pose
+/// of the humanoid and the quadruped): for every vertex, the vertex nearest to its
+/// reflection. Poses share the rest pose's vertex order, so the map serves them all, e.g.
+/// for flip-tolerant scores.
+pub fn mirror_map(rest: &FigureMesh) -> Vec<u32> {
+    let tree = crate::neighbors::PointTree::new(&rest.vertices);
+    rest.vertices
+        .iter()
+        .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)
+        .collect()
+}
