@@ -309,3 +309,59 @@ fn cancelling_inside_the_k_loop_stops_the_segmentation() {
     assert_eq!(reports.len(), 3, "{reports:?}");
     assert!(reports[2] > 0.0 && reports[2] < 1.0);
 }
+
+/// A small three-limbed star (about 600 vertices) for the awkward inputs below.
+fn small_star() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let star = synth::figure(&FigureSpec {
+        kind: FigureKind::Star { limbs: 3 },
+        target_vertices: 600,
+        ..Default::default()
+    })
+    .unwrap();
+    (star.vertices, star.triangles)
+}
+
+#[test]
+fn awkward_but_valid_inputs_give_an_answer_or_a_typed_error_never_a_panic() {
+    let (v, f) = small_star();
+    let n = v.len() as u32;
+    // Two separate copies plus unreferenced vertices.
+    let mut vertices = v.clone();
+    vertices.extend(v.iter().map(|p| [p[0] + 10.0, p[1], p[2]]));
+    vertices.extend([[50.0, 0.0, 0.0], [0.0, 50.0, 0.0]]);
+    let mut faces = f.clone();
+    faces.extend(f.iter().map(|t| t.map(|i| i + n)));
+    let two_pieces = Shape::mesh(vertices, &faces).unwrap();
+    let single = Shape::mesh(v.clone(), &f).unwrap();
+    // A point cloud with repeated points.
+    let mut points = v.clone();
+    points.extend_from_slice(&v[..50]);
+    let cloud = Shape::point_cloud(points).unwrap();
+    // The smallest shape the library accepts.
+    let tiny_points: Vec<[f64; 3]> = v.iter().step_by(v.len() / 40).take(40).copied().collect();
+    let tiny = Shape::point_cloud(tiny_points).unwrap();
+
+    let params = Params::default();
+    for (name, a, b) in [
+        ("two pieces vs one", &two_pieces, &single),
+        ("mesh vs cloud with duplicates", &single, &cloud),
+        ("tiny cloud vs mesh", &tiny, &single),
+    ] {
+        match Correspondence::compute(a, b, &params, &mut NoProgress) {
+            Ok(result) => {
+                println!("{name}: k = {}, {} matches", result.k, result.matches.len());
+                assert_eq!(result.regions_a().len(), a.n_vertices(), "{name}");
+                assert_eq!(result.regions_b().len(), b.n_vertices(), "{name}");
+                let n_a = result.graph_a.n_nodes() as u32;
+                assert!(result.regions_a().iter().all(|&r| r < n_a), "{name}");
+                for &(i, j) in &result.matches_one_to_one {
+                    assert!(result.matches.contains(&(i, j)), "{name}");
+                }
+            }
+            Err(e) => assert!(
+                matches!(e, Error::InvalidParameter { .. } | Error::Numerical { .. }),
+                "{name}: {e}"
+            ),
+        }
+    }
+}
