@@ -128,7 +128,12 @@ impl Correspondence {
         check(progress, Stage::Descriptors, 0.0)?;
         let t = Instant::now();
         let desc_a = hks(basis_a, &params.hks)?;
-        let desc_b = hks(basis_b, &params.hks)?;
+        // Symmetry detection passes the same basis twice: compute its HKS once.
+        let desc_b = if std::ptr::eq(basis_a, basis_b) {
+            desc_a.clone()
+        } else {
+            hks(basis_b, &params.hks)?
+        };
         timings.descriptors = t.elapsed().as_secs_f64();
 
         check(progress, Stage::Segmentation, 0.0)?;
