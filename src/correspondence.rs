@@ -60,6 +60,17 @@ impl Default for Params {
     }
 }
 
+impl Params {
+    /// Checks every parameter's range before any work starts, so a bad value fails at once
+    /// with [`crate::Error::InvalidParameter`] instead of after the eigensolver.
+    pub fn validate(&self) -> Result<()> {
+        self.eigen.validate()?;
+        self.hks.validate()?;
+        self.segmentation.validate()?;
+        self.matching.validate()
+    }
+}
+
 /// Seconds spent in each stage.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct Timings {
@@ -99,6 +110,7 @@ impl Correspondence {
         params: &Params,
         progress: &mut dyn Progress,
     ) -> Result<Correspondence> {
+        params.validate()?;
         let started = Instant::now();
         let basis_a = Eigenbasis::compute_with_progress(a, &params.eigen, progress)?;
         let t_a = started.elapsed().as_secs_f64();
@@ -122,6 +134,7 @@ impl Correspondence {
         params: &Params,
         progress: &mut dyn Progress,
     ) -> Result<Correspondence> {
+        params.validate()?;
         let started = Instant::now();
         let mut timings = Timings::default();
 
@@ -209,6 +222,24 @@ impl Correspondence {
     pub fn regions_b(&self) -> &[u32] {
         &self.graph_b.labels
     }
+
+    /// Per-vertex colours of A and B ([`region_colors`]): by the one-to-one matches when
+    /// `one_to_one` is true, else by the symmetric matches (a symmetric group shares one
+    /// colour).
+    pub fn vertex_colors(&self, one_to_one: bool) -> (Vec<[u8; 3]>, Vec<[u8; 3]>) {
+        let pairs = if one_to_one {
+            &self.matches_one_to_one
+        } else {
+            &self.matches
+        };
+        region_colors(
+            &self.graph_a.labels,
+            self.graph_a.n_nodes(),
+            &self.graph_b.labels,
+            self.graph_b.n_nodes(),
+            pairs,
+        )
+    }
 }
 
 /// Symmetric regions of one shape, found by matching the shape to itself (DESIGN step 14).
@@ -226,6 +257,7 @@ pub struct Symmetry {
 impl Symmetry {
     /// Self-symmetry groups of a shape.
     pub fn detect(shape: &Shape, params: &Params, progress: &mut dyn Progress) -> Result<Symmetry> {
+        params.validate()?;
         let basis = Eigenbasis::compute_with_progress(shape, &params.eigen, progress)?;
         Symmetry::from_basis(shape, &basis, params, progress)
     }
@@ -262,6 +294,24 @@ impl Symmetry {
             groups,
             matches: pair.matches,
         })
+    }
+}
+
+impl Symmetry {
+    /// Per-vertex colours: the regions of a group of two or more share a colour (one colour
+    /// per group), regions without a symmetric partner are [`UNMATCHED_COLOR`].
+    pub fn vertex_colors(&self) -> Vec<[u8; 3]> {
+        let mut region_colour = vec![UNMATCHED_COLOR; self.graph.n_nodes()];
+        for (index, group) in self.groups.iter().filter(|g| g.len() > 1).enumerate() {
+            for &region in group {
+                region_colour[region as usize] = palette(index);
+            }
+        }
+        self.graph
+            .labels
+            .iter()
+            .map(|&r| region_colour[r as usize])
+            .collect()
     }
 }
 

@@ -39,7 +39,8 @@ impl HksParams {
         log_space(self.t_min, self.t_max, self.n_times)
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<()> {
         if self.n_times == 0 {
             return Err(Error::InvalidParameter {
                 name: "hks.n_times",

@@ -129,6 +129,13 @@ impl Eigenbasis {
     }
 }
 
+impl EigenParams {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<()> {
+        validate(self)
+    }
+}
+
 fn validate(params: &EigenParams) -> Result<()> {
     let bad = |name, reason: &str| {
         Err(Error::InvalidParameter {

@@ -37,6 +37,9 @@ pub enum Error {
     /// The caller asked to stop through the progress callback.
     #[error("cancelled by the caller")]
     Cancelled,
+    /// An option name that does not exist (see [`crate::options::OPTIONS`]).
+    #[error("unknown option `{name}`; the options are: {known}")]
+    UnknownOption { name: String, known: String },
 }
 
 /// Result with the crate's [`Error`].

@@ -47,6 +47,7 @@ pub mod io;
 pub mod laplacian;
 pub mod matching;
 pub mod neighbors;
+pub mod options;
 pub mod progress;
 pub mod segmentation;
 pub mod shape;

@@ -600,15 +600,7 @@ fn symmetry_command(a: &Path, out: &Path, points: bool, params: &Params) -> Resu
     let symmetry = Symmetry::detect(&shape, params, &mut TerminalProgress);
     end_progress_line();
     let symmetry = symmetry?;
-    let n = symmetry.graph.n_nodes();
-    // Colour by group: every region of a group of two or more shares a colour.
-    let pairs: Vec<(u32, u32)> = symmetry
-        .groups
-        .iter()
-        .filter(|g| g.len() > 1)
-        .flat_map(|g| g.iter().map(move |&r| (g[0], r)))
-        .collect();
-    let (colors, _) = region_colors(&symmetry.graph.labels, n, &[], n, &pairs);
+    let colors = symmetry.vertex_colors();
     shapecorr::io::write_ply(
         &out.join("a_symmetry.ply"),
         shape.vertices(),
@@ -629,7 +621,7 @@ fn symmetry_command(a: &Path, out: &Path, points: bool, params: &Params) -> Resu
     let symmetric_groups = symmetry.groups.iter().filter(|g| g.len() > 1).count();
     println!(
         "{} regions, {} groups of symmetric regions -> {}",
-        n,
+        symmetry.graph.n_nodes(),
         symmetric_groups,
         out.display()
     );

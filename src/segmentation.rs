@@ -215,7 +215,8 @@ impl SegmentationParams {
         }
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<()> {
         let bad = |name, reason: String| Err(Error::InvalidParameter { name, reason });
         if self.k_min < 2 || self.k_min > self.k_max {
             return bad(

@@ -201,6 +201,18 @@ fn symmetry_detection_groups_the_limbs_of_a_star() {
         "the limb-tip regions form one group of 5: {:?}",
         symmetry.groups
     );
+    // Regression (the symmetry command coloured only the first region of each group and
+    // left the others dark grey): every region of the limb group has the group's colour.
+    let colors = symmetry.vertex_colors();
+    let group_colour = colors[tip];
+    assert_ne!(group_colour, shapecorr::correspondence::UNMATCHED_COLOR);
+    for (v, &region) in symmetry.graph.labels.iter().enumerate() {
+        if group.contains(&region) {
+            assert_eq!(colors[v], group_colour, "vertex {v} in region {region}");
+        } else {
+            assert_ne!(colors[v], group_colour, "vertex {v} outside the limb group");
+        }
+    }
 }
 
 #[test]
