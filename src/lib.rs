@@ -41,6 +41,7 @@ pub mod descriptors;
 pub mod eigen;
 pub mod error;
 pub mod evaluation;
+pub mod ffi;
 pub mod geodesic;
 pub mod graph;
 pub mod io;

@@ -63,33 +63,81 @@ use OptionType::{Bool, Float, Int};
 
 /// Every named option, in a stable order (new options are appended).
 pub const OPTIONS: &[OptionInfo] = &[
-    info("k_min", Int, "smallest number of joint clusters tried (paper: 5)"),
-    info("k_max", Int, "largest number of joint clusters tried (paper: 10)"),
-    info("kmeans_restarts", Int, "k-means++ starts per k; the lowest cost is kept"),
-    info("max_regions", Int, "graphs with more regions than this are not accepted"),
+    info(
+        "k_min",
+        Int,
+        "smallest number of joint clusters tried (paper: 5)",
+    ),
+    info(
+        "k_max",
+        Int,
+        "largest number of joint clusters tried (paper: 10)",
+    ),
+    info(
+        "kmeans_restarts",
+        Int,
+        "k-means++ starts per k; the lowest cost is kept",
+    ),
+    info(
+        "max_regions",
+        Int,
+        "graphs with more regions than this are not accepted",
+    ),
     info(
         "min_region_area",
         Float,
         "regions below this fraction of the area are merged into a neighbour",
     ),
-    info("seed", Int, "seed of every random choice (k-means++, eigensolver start, local search)"),
+    info(
+        "seed",
+        Int,
+        "seed of every random choice (k-means++, eigensolver start, local search)",
+    ),
     info("hks_times", Int, "number of heat kernel signature times"),
     info("hks_t_min", Float, "smallest HKS time (unit-area shape)"),
     info("hks_t_max", Float, "largest HKS time (unit-area shape)"),
     info("hks_log", Bool, "use the logarithm of the HKS"),
     info("eigenpairs", Int, "number of Laplacian eigenpairs"),
-    info("threads", Int, "threads of the eigensolver (0: all cores); results do not depend on it"),
-    info("sigma", Float, "width of the graph matching's Gaussian affinities"),
-    info("histogram_bins", Int, "bins of the graph-distance histograms"),
-    info("gap_ratio", Float, "a match scoring below ratio x the previous one ends the list"),
-    info("max_symmetry_order", Int, "largest number of matches per region"),
-    info("one_to_one", Bool, "break symmetries into a one-to-one region correspondence"),
+    info(
+        "threads",
+        Int,
+        "threads of the eigensolver (0: all cores); results do not depend on it",
+    ),
+    info(
+        "sigma",
+        Float,
+        "width of the graph matching's Gaussian affinities",
+    ),
+    info(
+        "histogram_bins",
+        Int,
+        "bins of the graph-distance histograms",
+    ),
+    info(
+        "gap_ratio",
+        Float,
+        "a match scoring below ratio x the previous one ends the list",
+    ),
+    info(
+        "max_symmetry_order",
+        Int,
+        "largest number of matches per region",
+    ),
+    info(
+        "one_to_one",
+        Bool,
+        "break symmetries into a one-to-one region correspondence",
+    ),
     info(
         "exhaustive_limit",
         Int,
         "one-to-one: largest number of combinations searched exhaustively",
     ),
-    info("symmetry_restarts", Int, "one-to-one: local-search restarts above that limit"),
+    info(
+        "symmetry_restarts",
+        Int,
+        "one-to-one: local-search restarts above that limit",
+    ),
 ];
 
 /// The option called `name`.

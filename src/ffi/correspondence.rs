@@ -1,0 +1,348 @@
+//! Region correspondence between two shapes: `sc_match` and the result's accessors.
+
+use std::ffi::{c_char, c_void};
+
+use super::boundary::{
+    boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
+    Failure, FfiResult, ScStatus,
+};
+use super::params::{params_or_default, ScParams};
+use super::shape::ScShape;
+use super::{CallbackProgress, ScProgressCallback};
+use crate::correspondence::Correspondence;
+use crate::graph::ShapeGraph;
+
+/// The result of `sc_match`. Immutable: one handle may be read from several threads at
+/// once. Free it with `sc_correspondence_free`.
+pub struct ScCorrespondence {
+    pub(crate) result: Correspondence,
+}
+
+/// Side A: the first shape given to `sc_match`.
+pub const SC_SIDE_A: u32 = 0;
+/// Side B: the second shape given to `sc_match`.
+pub const SC_SIDE_B: u32 = 1;
+/// The symmetric (many-to-many) region matches: a region may match all its symmetric
+/// copies on the other shape.
+pub const SC_MATCHES_SYMMETRIC: u32 = 0;
+/// The one-to-one region matches after symmetry breaking (a subset of the symmetric ones;
+/// empty when the option `one_to_one` is false).
+pub const SC_MATCHES_ONE_TO_ONE: u32 = 1;
+
+/// Region correspondence between shapes `a` and `b` (meshes, point clouds or one of each):
+/// eigenbases, heat kernel signatures, joint segmentation over the range of k, spectral
+/// graph matching, symmetry breaking. `params` may be NULL for the defaults; `progress`
+/// may be NULL; `userdata` is passed to it. The shapes are only read, so the same shapes may
+/// be matched from several threads at once. The result is deterministic for given shapes
+/// and parameters, whatever the number of threads.
+///
+/// Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work),
+/// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+///
+/// # Safety
+/// `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,
+/// `progress` NULL or a function safe to call with `userdata`; `out_correspondence`
+/// writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_match(
+    a: *const ScShape,
+    b: *const ScShape,
+    params: *const ScParams,
+    progress: ScProgressCallback,
+    userdata: *mut c_void,
+    out_correspondence: *mut *mut ScCorrespondence,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_correspondence, "out_correspondence")?;
+        let a = &handle(a, "a")?.shape;
+        let b = &handle(b, "b")?.shape;
+        let params = params_or_default(params);
+        let mut progress = CallbackProgress {
+            callback: progress,
+            userdata,
+        };
+        let result = Correspondence::compute(a, b, &params, &mut progress)?;
+        give_handle(out_correspondence, ScCorrespondence { result })
+    })
+}
+
+/// Frees a correspondence; NULL is a no-op.
+///
+/// # Safety
+/// `correspondence` must be NULL or live, not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_free(correspondence: *mut ScCorrespondence) {
+    free_handle(correspondence)
+}
+
+fn graph(c: &ScCorrespondence, side: u32) -> FfiResult<&ShapeGraph> {
+    match side {
+        SC_SIDE_A => Ok(&c.result.graph_a),
+        SC_SIDE_B => Ok(&c.result.graph_b),
+        _ => Err(Failure::invalid(format!(
+            "side must be SC_SIDE_A (0) or SC_SIDE_B (1), got {side}"
+        ))),
+    }
+}
+
+fn matches(c: &ScCorrespondence, kind: u32) -> FfiResult<&[(u32, u32)]> {
+    match kind {
+        SC_MATCHES_SYMMETRIC => Ok(&c.result.matches),
+        SC_MATCHES_ONE_TO_ONE => Ok(&c.result.matches_one_to_one),
+        _ => Err(Failure::invalid(format!(
+            "kind must be SC_MATCHES_SYMMETRIC (0) or SC_MATCHES_ONE_TO_ONE (1), got {kind}"
+        ))),
+    }
+}
+
+unsafe fn count(
+    c: *const ScCorrespondence,
+    f: impl FnOnce(&ScCorrespondence) -> FfiResult<usize>,
+) -> usize {
+    boundary_value(0, || f(handle(c, "correspondence")?))
+}
+
+/// The number of joint clusters chosen (0 for NULL).
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_k(correspondence: *const ScCorrespondence) -> u32 {
+    count(correspondence, |c| Ok(c.result.k)) as u32
+}
+
+/// Number of vertices of one side (as given to `sc_match`); 0 for NULL or a bad side.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_n_vertices(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+) -> usize {
+    count(correspondence, |c| Ok(graph(c, side)?.labels.len()))
+}
+
+/// Number of regions (shape-graph nodes) of one side; region ids run from 0 to this - 1.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_n_regions(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+) -> usize {
+    count(correspondence, |c| Ok(graph(c, side)?.n_nodes()))
+}
+
+/// Copies the region id of every vertex of one side, in the caller's vertex order
+/// (`sc_correspondence_n_vertices` values) into `out_regions` of `len` elements.
+///
+/// # Safety
+/// `correspondence` must be live; `out_regions` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_regions(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_regions: *mut u32,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        write_output(out_regions, len, &graph(c, side)?.labels, "out_regions")
+    })
+}
+
+/// Number of region matches of a kind (`SC_MATCHES_SYMMETRIC` or `SC_MATCHES_ONE_TO_ONE`).
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_n_matches(
+    correspondence: *const ScCorrespondence,
+    kind: u32,
+) -> usize {
+    count(correspondence, |c| Ok(matches(c, kind)?.len()))
+}
+
+/// Copies the matches of a kind as pairs `region_a0 region_b0 region_a1 ...`
+/// (`2 * sc_correspondence_n_matches` values, sorted) into `out_pairs` of `len` elements.
+///
+/// # Safety
+/// `correspondence` must be live; `out_pairs` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_matches(
+    correspondence: *const ScCorrespondence,
+    kind: u32,
+    out_pairs: *mut u32,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        let flat: Vec<u32> = matches(c, kind)?
+            .iter()
+            .flat_map(|&(i, j)| [i, j])
+            .collect();
+        write_output(out_pairs, len, &flat, "out_pairs")
+    })
+}
+
+/// Copies a colour per vertex of one side as RGBA bytes (`4 * sc_correspondence_n_vertices`
+/// values, alpha 255) into `out_rgba` of `len` bytes: regions linked by matches of `kind`
+/// share a colour on both shapes, unmatched regions are dark grey (64, 64, 64).
+///
+/// # Safety
+/// `correspondence` must be live; `out_rgba` must point to `len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_colors(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    kind: u32,
+    out_rgba: *mut u8,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        graph(c, side)?;
+        matches(c, kind)?;
+        let (a, b) = c.result.vertex_colors(kind == SC_MATCHES_ONE_TO_ONE);
+        let colors = if side == SC_SIDE_A { a } else { b };
+        write_output(out_rgba, len, &rgba(&colors), "out_rgba")
+    })
+}
+
+/// RGB colours as packed RGBA bytes with alpha 255.
+pub(crate) fn rgba(colors: &[[u8; 3]]) -> Vec<u8> {
+    colors
+        .iter()
+        .flat_map(|&[r, g, b]| [r, g, b, 255])
+        .collect()
+}
+
+/// Length of each region's mean descriptor (the number of HKS times).
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_descriptor_length(
+    correspondence: *const ScCorrespondence,
+) -> usize {
+    count(correspondence, |c| {
+        Ok(c.result.graph_a.node_descriptor.first().map_or(0, Vec::len))
+    })
+}
+
+/// Copies each region's area, as a fraction of its shape's area
+/// (`sc_correspondence_n_regions` values), into `out_areas` of `len` elements.
+///
+/// # Safety
+/// `correspondence` must be live; `out_areas` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_region_areas(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_areas: *mut f64,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        write_output(out_areas, len, &graph(c, side)?.node_area, "out_areas")
+    })
+}
+
+/// Copies each region's mean descriptor, row by row (`n_regions * descriptor_length`
+/// values), into `out_descriptors` of `len` elements.
+///
+/// # Safety
+/// `correspondence` must be live; `out_descriptors` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_region_descriptors(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_descriptors: *mut f64,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        let flat: Vec<f64> = graph(c, side)?
+            .node_descriptor
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        write_output(out_descriptors, len, &flat, "out_descriptors")
+    })
+}
+
+/// Number of edges of one side's shape graph (regions that touch).
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_n_edges(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+) -> usize {
+    count(correspondence, |c| Ok(graph(c, side)?.edges.len()))
+}
+
+/// Copies one side's graph edges as pairs `r0 s0 r1 s1 ...` (`2 * sc_correspondence_n_edges`
+/// values, each pair with r < s) into `out_edges` of `len` elements.
+///
+/// # Safety
+/// `correspondence` must be live; `out_edges` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_edges(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_edges: *mut u32,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        let flat: Vec<u32> = graph(c, side)?
+            .edges
+            .iter()
+            .flat_map(|&(i, j)| [i, j])
+            .collect();
+        write_output(out_edges, len, &flat, "out_edges")
+    })
+}
+
+/// Seconds spent in a stage of the call: `stage` is one of `"eigenbasis_a"`,
+/// `"eigenbasis_b"`, `"descriptors"`, `"segmentation"`, `"matching"`, `"one_to_one"`,
+/// `"total"`.
+///
+/// # Safety
+/// `correspondence` must be live; `stage` a NUL-terminated string; `out_seconds` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_seconds(
+    correspondence: *const ScCorrespondence,
+    stage: *const c_char,
+    out_seconds: *mut f64,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        let stage = input_str(stage, "stage")?;
+        let out = out_seconds
+            .as_mut()
+            .ok_or_else(|| Failure::null("out_seconds"))?;
+        let t = &c.result.timings;
+        *out = match stage {
+            "eigenbasis_a" => t.eigenbasis_a,
+            "eigenbasis_b" => t.eigenbasis_b,
+            "descriptors" => t.descriptors,
+            "segmentation" => t.segmentation,
+            "matching" => t.matching,
+            "one_to_one" => t.one_to_one,
+            "total" => t.total,
+            other => {
+                return Err(Failure::invalid(format!(
+                    "unknown stage `{other}`; use eigenbasis_a, eigenbasis_b, descriptors, \
+                     segmentation, matching, one_to_one or total"
+                )))
+            }
+        };
+        Ok(())
+    })
+}

@@ -1,0 +1,265 @@
+//! Parameters: a handle holding every option, set and read by name. Defaults are
+//! `Params::default()`, the same as the command line's and the add-ons'.
+
+use std::ffi::{c_char, CString};
+use std::sync::OnceLock;
+
+use super::boundary::{
+    boundary, check_out, free_handle, give_handle, handle, input_str, Failure, FfiResult, ScStatus,
+};
+use crate::correspondence::Params;
+use crate::options::{option_info, OptionType, OptionValue, OPTIONS};
+
+/// Every parameter of the method. Setters change it; use one handle from one thread while
+/// setting, after which it may be shared for reading by concurrent `sc_match` calls.
+/// Free it with `sc_params_free`.
+pub struct ScParams {
+    pub(crate) params: Params,
+}
+
+/// An integer option (`sc_params_set_int`).
+pub const SC_OPTION_INT: u32 = 0;
+/// A floating-point option (`sc_params_set_double`).
+pub const SC_OPTION_DOUBLE: u32 = 1;
+/// A boolean option (`sc_params_set_bool`).
+pub const SC_OPTION_BOOL: u32 = 2;
+
+/// New parameters with the documented defaults.
+///
+/// # Safety
+/// `out_params` must be writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_new(out_params: *mut *mut ScParams) -> ScStatus {
+    boundary(|| {
+        check_out(out_params, "out_params")?;
+        give_handle(
+            out_params,
+            ScParams {
+                params: Params::default(),
+            },
+        )
+    })
+}
+
+/// Frees parameters; NULL is a no-op.
+///
+/// # Safety
+/// `params` must be NULL or live parameters, not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_free(params: *mut ScParams) {
+    free_handle(params)
+}
+
+unsafe fn set(params: *mut ScParams, name: *const c_char, value: OptionValue) -> ScStatus {
+    boundary(|| {
+        let name = input_str(name, "name")?;
+        let params = params.as_mut().ok_or_else(|| Failure::null("params"))?;
+        let info = option_info(name)?;
+        if info.option_type != value.option_type() {
+            return Err(Failure::invalid(format!(
+                "option `{name}` is {}; use sc_params_set_{}",
+                type_name(info.option_type),
+                setter_suffix(info.option_type)
+            )));
+        }
+        Ok(params.params.set_option(name, value)?)
+    })
+}
+
+unsafe fn get(
+    params: *const ScParams,
+    name: *const c_char,
+    wanted: OptionType,
+) -> FfiResult<OptionValue> {
+    let name = input_str(name, "name")?;
+    let params = handle(params, "params")?;
+    let info = option_info(name)?;
+    if info.option_type != wanted {
+        return Err(Failure::invalid(format!(
+            "option `{name}` is {}; use sc_params_get_{}",
+            type_name(info.option_type),
+            setter_suffix(info.option_type)
+        )));
+    }
+    Ok(params.params.option(name)?)
+}
+
+fn type_name(t: OptionType) -> &'static str {
+    match t {
+        OptionType::Int => "an integer",
+        OptionType::Float => "a double",
+        OptionType::Bool => "a bool",
+    }
+}
+
+fn setter_suffix(t: OptionType) -> &'static str {
+    match t {
+        OptionType::Int => "int",
+        OptionType::Float => "double",
+        OptionType::Bool => "bool",
+    }
+}
+
+/// Sets an integer option by name (see `sc_option_name`). Errors:
+/// `SC_STATUS_UNKNOWN_OPTION`, `SC_STATUS_INVALID_ARGUMENT` (the option is not an
+/// integer), `SC_STATUS_INVALID_PARAMETER` (negative). Ranges that involve several options
+/// (k_min <= k_max) are checked when the parameters are used.
+///
+/// # Safety
+/// `params` must be live parameters; `name` a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_set_int(
+    params: *mut ScParams,
+    name: *const c_char,
+    value: i64,
+) -> ScStatus {
+    set(params, name, OptionValue::Int(value))
+}
+
+/// Sets a floating-point option by name (errors as `sc_params_set_int`; NaN and infinity
+/// are `SC_STATUS_INVALID_PARAMETER`).
+///
+/// # Safety
+/// `params` must be live parameters; `name` a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_set_double(
+    params: *mut ScParams,
+    name: *const c_char,
+    value: f64,
+) -> ScStatus {
+    set(params, name, OptionValue::Float(value))
+}
+
+/// Sets a boolean option by name (errors as `sc_params_set_int`).
+///
+/// # Safety
+/// `params` must be live parameters; `name` a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_set_bool(
+    params: *mut ScParams,
+    name: *const c_char,
+    value: bool,
+) -> ScStatus {
+    set(params, name, OptionValue::Bool(value))
+}
+
+/// Reads an integer option into `*out_value`.
+///
+/// # Safety
+/// `params` must be live parameters; `name` a NUL-terminated string; `out_value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_get_int(
+    params: *const ScParams,
+    name: *const c_char,
+    out_value: *mut i64,
+) -> ScStatus {
+    boundary(|| {
+        let out = out_value
+            .as_mut()
+            .ok_or_else(|| Failure::null("out_value"))?;
+        if let OptionValue::Int(v) = get(params, name, OptionType::Int)? {
+            *out = v;
+        }
+        Ok(())
+    })
+}
+
+/// Reads a floating-point option into `*out_value`.
+///
+/// # Safety
+/// `params` must be live parameters; `name` a NUL-terminated string; `out_value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_get_double(
+    params: *const ScParams,
+    name: *const c_char,
+    out_value: *mut f64,
+) -> ScStatus {
+    boundary(|| {
+        let out = out_value
+            .as_mut()
+            .ok_or_else(|| Failure::null("out_value"))?;
+        if let OptionValue::Float(v) = get(params, name, OptionType::Float)? {
+            *out = v;
+        }
+        Ok(())
+    })
+}
+
+/// Reads a boolean option into `*out_value`.
+///
+/// # Safety
+/// `params` must be live parameters; `name` a NUL-terminated string; `out_value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_get_bool(
+    params: *const ScParams,
+    name: *const c_char,
+    out_value: *mut bool,
+) -> ScStatus {
+    boundary(|| {
+        let out = out_value
+            .as_mut()
+            .ok_or_else(|| Failure::null("out_value"))?;
+        if let OptionValue::Bool(v) = get(params, name, OptionType::Bool)? {
+            *out = v;
+        }
+        Ok(())
+    })
+}
+
+fn option_strings() -> &'static [(CString, CString)] {
+    static STRINGS: OnceLock<Vec<(CString, CString)>> = OnceLock::new();
+    STRINGS.get_or_init(|| {
+        OPTIONS
+            .iter()
+            .map(|o| {
+                (
+                    CString::new(o.name).expect("option names have no NUL"),
+                    CString::new(o.doc).expect("option docs have no NUL"),
+                )
+            })
+            .collect()
+    })
+}
+
+/// Number of options; they are numbered `0 .. sc_option_count() - 1` in a stable order
+/// (new options are appended).
+#[no_mangle]
+pub extern "C" fn sc_option_count() -> usize {
+    OPTIONS.len()
+}
+
+/// Name of option `index` (static; never free it), or NULL past the end.
+#[no_mangle]
+pub extern "C" fn sc_option_name(index: usize) -> *const c_char {
+    option_strings()
+        .get(index)
+        .map_or(std::ptr::null(), |(name, _)| name.as_ptr())
+}
+
+/// One-line description of option `index` (static), or NULL past the end.
+#[no_mangle]
+pub extern "C" fn sc_option_doc(index: usize) -> *const c_char {
+    option_strings()
+        .get(index)
+        .map_or(std::ptr::null(), |(_, doc)| doc.as_ptr())
+}
+
+/// Type of option `index`: `SC_OPTION_INT`, `SC_OPTION_DOUBLE` or `SC_OPTION_BOOL`;
+/// `UINT32_MAX` past the end.
+#[no_mangle]
+pub extern "C" fn sc_option_type(index: usize) -> u32 {
+    OPTIONS
+        .get(index)
+        .map_or(u32::MAX, |o| match o.option_type {
+            OptionType::Int => SC_OPTION_INT,
+            OptionType::Float => SC_OPTION_DOUBLE,
+            OptionType::Bool => SC_OPTION_BOOL,
+        })
+}
+
+/// The parameters behind a nullable handle: NULL means the defaults.
+pub(crate) unsafe fn params_or_default(params: *const ScParams) -> Params {
+    params
+        .as_ref()
+        .map_or_else(Params::default, |p| p.params.clone())
+}

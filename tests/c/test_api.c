@@ -1,0 +1,596 @@
+/*
+ * C API tests: the whole life cycle on generated figures, every error path, cancellation,
+ * concurrent calls on shared handles, and the version check. Compiled as C99 with
+ * -Wall -Wextra -Wpedantic -Werror against include/shapecorr.h and linked against the
+ * built libshapecorr.so by tests/c/run.sh (plain, under ASan+UBSan, and under valgrind).
+ *
+ * SHAPECORR_TEST_QUICK=1 (used under valgrind) makes the figures smaller and the thread
+ * test shorter; the checks are the same.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "shapecorr.h"
+
+#ifndef CARGO_VERSION
+#error "compile with -DCARGO_VERSION=\"x.y.z\" (the version in Cargo.toml)"
+#endif
+
+static int failures = 0;
+static int checks = 0;
+
+#define CHECK(cond, ...)                                                                  \
+    do {                                                                                  \
+        checks++;                                                                         \
+        if (!(cond)) {                                                                    \
+            failures++;                                                                   \
+            fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);               \
+            fprintf(stderr, __VA_ARGS__);                                                 \
+            fprintf(stderr, "\n");                                                        \
+        }                                                                                 \
+    } while (0)
+
+#define CHECK_STATUS(call, expected)                                                      \
+    do {                                                                                  \
+        sc_status got_ = (call);                                                          \
+        CHECK(got_ == (expected), "got status %u (%s), expected %u; last error: %s",      \
+              (unsigned)got_, sc_status_str(got_), (unsigned)(expected), sc_last_error()); \
+    } while (0)
+
+static int quick = 0;
+
+static double now_seconds(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static sc_shape *figure(const char *kind, uint32_t pose) {
+    sc_shape *shape = NULL;
+    CHECK_STATUS(sc_shape_new_figure(kind, pose, quick ? 700 : 2500, &shape), SC_STATUS_OK);
+    return shape;
+}
+
+/* ---------------------------------------------------------------- version and statuses */
+
+static void test_version(void) {
+    char expected[64];
+    snprintf(expected, sizeof expected, "%d.%d.%d", SC_VERSION_MAJOR, SC_VERSION_MINOR,
+             SC_VERSION_PATCH);
+    CHECK(strcmp(expected, CARGO_VERSION) == 0, "header %s vs Cargo.toml %s", expected,
+          CARGO_VERSION);
+    CHECK(strcmp(sc_version(), CARGO_VERSION) == 0, "runtime %s vs Cargo.toml %s",
+          sc_version(), CARGO_VERSION);
+    CHECK(sc_version_major() == SC_VERSION_MAJOR, "major");
+    CHECK(sc_version_minor() == SC_VERSION_MINOR, "minor");
+    CHECK(sc_version_patch() == SC_VERSION_PATCH, "patch");
+    CHECK(sc_abi_version() == SC_ABI_VERSION, "abi %u", sc_abi_version());
+}
+
+static void test_status_text(void) {
+    CHECK(strcmp(sc_status_str(SC_STATUS_OK), "success") == 0, "%s", sc_status_str(0));
+    CHECK(strstr(sc_status_str(SC_STATUS_CANCELLED), "cancel") != NULL, "cancelled text");
+    CHECK(strcmp(sc_status_str(77777), "unknown status") == 0, "unknown status text");
+    CHECK(sc_last_error() != NULL, "last error is never NULL");
+}
+
+/* ---------------------------------------------------------------------------- options */
+
+static void test_options(void) {
+    size_t n = sc_option_count();
+    size_t i;
+    sc_params *params = NULL;
+    int64_t k = 0;
+    double gap = 0.0;
+    bool one_to_one = false;
+    CHECK(n >= 10, "%zu options", n);
+    for (i = 0; i < n; i++) {
+        CHECK(sc_option_name(i) != NULL && strlen(sc_option_name(i)) > 0, "name %zu", i);
+        CHECK(sc_option_doc(i) != NULL, "doc %zu", i);
+        CHECK(sc_option_type(i) <= SC_OPTION_BOOL, "type %zu", i);
+    }
+    CHECK(sc_option_name(n) == NULL, "past the end");
+    CHECK(sc_option_type(n) == UINT32_MAX, "past the end");
+
+    CHECK_STATUS(sc_params_new(NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    /* Defaults are the documented ones. */
+    CHECK_STATUS(sc_params_get_int(params, "k_min", &k), SC_STATUS_OK);
+    CHECK(k == 5, "default k_min %lld", (long long)k);
+    CHECK_STATUS(sc_params_get_double(params, "gap_ratio", &gap), SC_STATUS_OK);
+    CHECK(fabs(gap - 0.9) < 1e-12, "default gap %g", gap);
+    CHECK_STATUS(sc_params_get_bool(params, "one_to_one", &one_to_one), SC_STATUS_OK);
+    CHECK(one_to_one, "one-to-one on by default");
+
+    CHECK_STATUS(sc_params_set_int(params, "k_min", 6), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_get_int(params, "k_min", &k), SC_STATUS_OK);
+    CHECK(k == 6, "k_min read back %lld", (long long)k);
+    CHECK_STATUS(sc_params_set_double(params, "gap_ratio", 0.85), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_get_double(params, "gap_ratio", &gap), SC_STATUS_OK);
+    CHECK(gap == 0.85, "gap read back %g", gap);
+
+    /* Errors: unknown name, wrong type, bad value, NULLs; values unchanged after each. */
+    CHECK_STATUS(sc_params_set_int(params, "k_mni", 6), SC_STATUS_UNKNOWN_OPTION);
+    CHECK(strstr(sc_last_error(), "k_mni") != NULL, "message names the option: %s",
+          sc_last_error());
+    CHECK(strstr(sc_last_error(), "k_min") != NULL, "message lists the options");
+    CHECK_STATUS(sc_params_set_double(params, "k_min", 6.0), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_params_set_int(params, "k_min", -1), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_double(params, "gap_ratio", NAN), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_bool(params, "gap_ratio", true), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_params_get_bool(params, "k_min", &one_to_one), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_params_set_int(NULL, "k_min", 6), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_set_int(params, NULL, 6), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_get_int(params, "k_min", NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_get_int(params, "k_min", &k), SC_STATUS_OK);
+    CHECK(k == 6, "k_min unchanged by failed calls: %lld", (long long)k);
+    CHECK_STATUS(sc_params_get_double(params, "gap_ratio", &gap), SC_STATUS_OK);
+    CHECK(gap == 0.85, "gap unchanged by failed calls: %g", gap);
+    sc_params_free(params);
+    sc_params_free(NULL);
+}
+
+/* ------------------------------------------------------------------------ shape errors */
+
+static void test_shape_errors(void) {
+    /* A valid tetrahedron-like fan is too small; build 40 points on a sphere instead. */
+    double xyz[3 * 40];
+    uint32_t tri_bad[3] = {0, 1, 40};
+    sc_shape *sentinel = (sc_shape *)(void *)&checks; /* must stay untouched on failure */
+    sc_shape *shape = sentinel;
+    int i;
+    char path[] = "/tmp/shapecorr_c_test_XXXXXX";
+    int fd;
+    FILE *f;
+    for (i = 0; i < 40; i++) {
+        double z = -1.0 + (2.0 * i + 1.0) / 40.0, r = sqrt(1.0 - z * z), a = 2.4 * i;
+        xyz[3 * i] = r * cos(a);
+        xyz[3 * i + 1] = r * sin(a);
+        xyz[3 * i + 2] = z;
+    }
+
+    CHECK_STATUS(sc_shape_new_mesh(xyz, 40, tri_bad, 1, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_shape_new_mesh(NULL, 40, tri_bad, 1, &shape), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_shape_new_mesh(xyz, 40, NULL, 1, &shape), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_shape_new_mesh(xyz, 40, tri_bad, 1, &shape),
+                 SC_STATUS_FACE_INDEX_OUT_OF_RANGE);
+    CHECK(strstr(sc_last_error(), "40") != NULL, "names the index: %s", sc_last_error());
+    CHECK_STATUS(sc_shape_new_mesh(NULL, 0, NULL, 0, &shape), SC_STATUS_TOO_FEW_VERTICES);
+    CHECK_STATUS(sc_shape_new_point_cloud(NULL, 0, &shape), SC_STATUS_TOO_FEW_VERTICES);
+    CHECK_STATUS(sc_shape_new_point_cloud(xyz, 10, &shape), SC_STATUS_TOO_FEW_VERTICES);
+    CHECK_STATUS(sc_shape_new_mesh(xyz, 40, NULL, 0, &shape), SC_STATUS_ZERO_AREA);
+    CHECK_STATUS(sc_shape_new_point_cloud(xyz, (size_t)-1, &shape), SC_STATUS_INVALID_ARGUMENT);
+    xyz[7] = NAN;
+    CHECK_STATUS(sc_shape_new_point_cloud(xyz, 40, &shape), SC_STATUS_NON_FINITE_COORDINATE);
+    xyz[7] = INFINITY;
+    CHECK_STATUS(sc_shape_new_point_cloud(xyz, 40, &shape), SC_STATUS_NON_FINITE_COORDINATE);
+    CHECK(strstr(sc_last_error(), "vertex 2") != NULL, "names the vertex: %s", sc_last_error());
+    xyz[7] = 0.5;
+    CHECK_STATUS(sc_shape_new_point_cloud(xyz, 40, &shape), SC_STATUS_OK);
+    CHECK(shape != sentinel && sc_shape_is_point_cloud(shape), "point cloud made");
+    CHECK(sc_shape_n_vertices(shape) == 40, "40 points");
+    CHECK(sc_shape_n_triangles(shape) == 0, "no triangles");
+    sc_shape_free(shape);
+    shape = sentinel;
+
+    CHECK_STATUS(sc_shape_new_figure("dragon", 0, 1000, &shape), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_shape_new_figure("humanoid", 99, 1000, &shape),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_shape_new_figure(NULL, 0, 1000, &shape), SC_STATUS_NULL_ARGUMENT);
+
+    /* Files: missing, malformed. */
+    CHECK_STATUS(sc_shape_read("/nonexistent/shape.ply", false, &shape), SC_STATUS_FILE_ERROR);
+    CHECK(strstr(sc_last_error(), "/nonexistent/shape.ply") != NULL, "names the file: %s",
+          sc_last_error());
+    fd = mkstemp(path);
+    CHECK(fd >= 0, "temporary file");
+    f = fdopen(fd, "w");
+    fputs("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1 2\n", f);
+    fclose(f);
+    CHECK_STATUS(sc_shape_read(path, false, &shape), SC_STATUS_FILE_ERROR);
+    remove(path);
+    CHECK_STATUS(sc_shape_read(NULL, false, &shape), SC_STATUS_NULL_ARGUMENT);
+    CHECK(shape == sentinel, "no output written by failed calls");
+
+    CHECK(sc_shape_n_vertices(NULL) == 0, "NULL shape has no vertices");
+    CHECK(sc_shape_warnings(NULL, NULL, 0) == 0, "NULL shape has no warnings");
+    sc_shape_free(NULL);
+}
+
+/* ----------------------------------------------------------------------- life cycle */
+
+struct progress_log {
+    int calls;
+    uint32_t last_stage;
+    int bad;
+    int cancel_at_stage; /* 0: never cancel */
+    double cancelled_at;
+};
+
+static bool record_progress(void *userdata, uint32_t stage, float fraction) {
+    struct progress_log *log = (struct progress_log *)userdata;
+    log->calls++;
+    if (stage < SC_STAGE_LAPLACIAN || stage > SC_STAGE_SYMMETRY_BREAKING || !(fraction >= 0.0f) ||
+        !(fraction <= 1.0f))
+        log->bad++;
+    log->last_stage = stage;
+    if (log->cancel_at_stage != 0 && stage == (uint32_t)log->cancel_at_stage) {
+        if (log->cancelled_at == 0.0)
+            log->cancelled_at = now_seconds();
+        return false;
+    }
+    return true;
+}
+
+/* Fraction of vertices whose regions on A and B (same vertex order) are matched. */
+static double region_accuracy(const sc_correspondence *c, uint32_t kind) {
+    size_t n = sc_correspondence_n_vertices(c, SC_SIDE_A);
+    size_t n_matches = sc_correspondence_n_matches(c, kind);
+    size_t na = sc_correspondence_n_regions(c, SC_SIDE_A);
+    size_t nb = sc_correspondence_n_regions(c, SC_SIDE_B);
+    uint32_t *ra = malloc(n * sizeof *ra), *rb = malloc(n * sizeof *rb);
+    uint32_t *pairs = malloc((2 * n_matches + 1) * sizeof *pairs);
+    unsigned char *matched = calloc(na * nb, 1);
+    size_t i, good = 0;
+    CHECK_STATUS(sc_correspondence_regions(c, SC_SIDE_A, ra, n), SC_STATUS_OK);
+    CHECK_STATUS(sc_correspondence_regions(c, SC_SIDE_B, rb, n), SC_STATUS_OK);
+    CHECK_STATUS(sc_correspondence_matches(c, kind, pairs, 2 * n_matches), SC_STATUS_OK);
+    for (i = 0; i < n_matches; i++) {
+        CHECK(pairs[2 * i] < na && pairs[2 * i + 1] < nb, "match %zu in range", i);
+        if (pairs[2 * i] < na && pairs[2 * i + 1] < nb)
+            matched[pairs[2 * i] * nb + pairs[2 * i + 1]] = 1;
+    }
+    for (i = 0; i < n; i++) {
+        CHECK(ra[i] < na && rb[i] < nb, "vertex %zu regions in range", i);
+        if (ra[i] < na && rb[i] < nb && matched[ra[i] * nb + rb[i]])
+            good++;
+    }
+    free(ra);
+    free(rb);
+    free(pairs);
+    free(matched);
+    return (double)good / (double)n;
+}
+
+static void test_life_cycle(void) {
+    sc_shape *a = figure("humanoid", 0), *b_mesh = figure("humanoid", 3), *b = NULL;
+    sc_params *params = NULL;
+    sc_correspondence *c = NULL;
+    struct progress_log log = {0, 0, 0, 0, 0.0};
+    size_t nv, nt, na, nb, dim, ne, i;
+    double *xyz_d, sym, one, area, seconds, total;
+    float *xyz_f;
+    uint32_t *tri, *regions, *edges;
+    uint8_t *rgba, *rgba_b;
+    double *areas, *descriptors;
+    if (a == NULL || b_mesh == NULL)
+        return;
+
+    /* Copy B out and back in through the float path: the same shape. */
+    nv = sc_shape_n_vertices(b_mesh);
+    nt = sc_shape_n_triangles(b_mesh);
+    xyz_d = malloc(3 * nv * sizeof *xyz_d);
+    xyz_f = malloc(3 * nv * sizeof *xyz_f);
+    tri = malloc(3 * nt * sizeof *tri);
+    CHECK_STATUS(sc_shape_vertices(b_mesh, xyz_d, 3 * nv), SC_STATUS_OK);
+    CHECK_STATUS(sc_shape_triangles(b_mesh, tri, 3 * nt), SC_STATUS_OK);
+    CHECK_STATUS(sc_shape_vertices(b_mesh, xyz_d, 3 * nv - 1), SC_STATUS_BUFFER_TOO_SMALL);
+    for (i = 0; i < 3 * nv; i++)
+        xyz_f[i] = (float)xyz_d[i];
+    CHECK_STATUS(sc_shape_new_mesh_f32(xyz_f, nv, tri, nt, &b), SC_STATUS_OK);
+    CHECK(sc_shape_n_vertices(b) == nv && sc_shape_n_triangles(b) == nt, "float copy");
+    CHECK(!sc_shape_is_point_cloud(b), "a mesh");
+
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, b, params, record_progress, &log, &c), SC_STATUS_OK);
+    CHECK(log.calls > 5 && log.bad == 0, "%d progress calls, %d bad", log.calls, log.bad);
+    CHECK(c != NULL, "result");
+    if (c == NULL)
+        goto done;
+
+    CHECK(sc_correspondence_k(c) >= 5 && sc_correspondence_k(c) <= 10, "k = %u",
+          sc_correspondence_k(c));
+    CHECK(sc_correspondence_n_vertices(c, SC_SIDE_A) == sc_shape_n_vertices(a), "n A");
+    CHECK(sc_correspondence_n_vertices(c, SC_SIDE_B) == nv, "n B");
+    na = sc_correspondence_n_regions(c, SC_SIDE_A);
+    nb = sc_correspondence_n_regions(c, SC_SIDE_B);
+    CHECK(na >= 5 && nb >= 5, "%zu and %zu regions", na, nb);
+    sym = region_accuracy(c, SC_MATCHES_SYMMETRIC);
+    one = region_accuracy(c, SC_MATCHES_ONE_TO_ONE);
+    printf("life cycle: %zu vs %zu vertices, k = %u, %zu/%zu regions, accuracy symmetric "
+           "%.3f, one-to-one %.3f\n",
+           sc_shape_n_vertices(a), nv, sc_correspondence_k(c), na, nb, sym, one);
+    CHECK(sym >= (quick ? 0.7 : 0.9), "symmetric accuracy %.3f", sym);
+    CHECK(sc_correspondence_n_matches(c, SC_MATCHES_ONE_TO_ONE) <=
+              sc_correspondence_n_matches(c, SC_MATCHES_SYMMETRIC),
+          "one-to-one is a subset");
+
+    /* Colours: same length rules; a vertex pair in one-to-one matched regions shares colour. */
+    rgba = malloc(4 * nv);
+    rgba_b = malloc(4 * nv);
+    regions = malloc(nv * sizeof *regions);
+    CHECK(sc_correspondence_n_vertices(c, SC_SIDE_A) == nv, "poses share the vertex order");
+    CHECK_STATUS(sc_correspondence_colors(c, SC_SIDE_A, SC_MATCHES_ONE_TO_ONE, rgba, 4 * nv - 1),
+                 SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_correspondence_colors(c, SC_SIDE_A, SC_MATCHES_ONE_TO_ONE, rgba, 4 * nv),
+                 SC_STATUS_OK);
+    CHECK_STATUS(sc_correspondence_colors(c, SC_SIDE_B, SC_MATCHES_ONE_TO_ONE, rgba_b, 4 * nv),
+                 SC_STATUS_OK);
+    {
+        /* Where the vertex's regions are matched one-to-one, both shapes show one colour. */
+        size_t same = 0;
+        for (i = 0; i < nv; i++)
+            same += memcmp(rgba + 4 * i, rgba_b + 4 * i, 4) == 0;
+        CHECK((double)same / (double)nv >= one - 1e-9, "colour agreement %.3f vs one-to-one %.3f",
+              (double)same / (double)nv, one);
+    }
+    for (i = 0; i < nv; i++)
+        CHECK(rgba_b[4 * i + 3] == 255, "alpha");
+    CHECK_STATUS(sc_correspondence_colors(c, 2, SC_MATCHES_ONE_TO_ONE, rgba_b, 4 * nv),
+                 SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_colors(c, SC_SIDE_B, 7, rgba_b, 4 * nv),
+                 SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_colors(c, SC_SIDE_B, SC_MATCHES_SYMMETRIC, NULL, 4 * nv),
+                 SC_STATUS_NULL_ARGUMENT);
+
+    /* Buffer too small leaves the buffer untouched. */
+    memset(regions, 0xAB, nv * sizeof *regions);
+    CHECK_STATUS(sc_correspondence_regions(c, SC_SIDE_B, regions, nv - 1),
+                 SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK(regions[0] == 0xABABABABu, "untouched on failure");
+    CHECK_STATUS(sc_correspondence_regions(NULL, SC_SIDE_B, regions, nv), SC_STATUS_NULL_ARGUMENT);
+    CHECK(sc_correspondence_n_regions(c, 5) == 0, "bad side counts 0");
+
+    /* Shape graphs: areas sum to 1, descriptors of the HKS length, edges in range. */
+    dim = sc_correspondence_descriptor_length(c);
+    CHECK(dim == 15, "descriptor length %zu", dim);
+    areas = malloc(nb * sizeof *areas);
+    descriptors = malloc(nb * dim * sizeof *descriptors);
+    CHECK_STATUS(sc_correspondence_region_areas(c, SC_SIDE_B, areas, nb), SC_STATUS_OK);
+    area = 0.0;
+    for (i = 0; i < nb; i++)
+        area += areas[i];
+    CHECK(fabs(area - 1.0) < 1e-9, "areas sum to %.12f", area);
+    CHECK_STATUS(sc_correspondence_region_descriptors(c, SC_SIDE_B, descriptors, nb * dim),
+                 SC_STATUS_OK);
+    for (i = 0; i < nb * dim; i++)
+        CHECK(isfinite(descriptors[i]) && descriptors[i] >= 0.0, "descriptor %zu", i);
+    ne = sc_correspondence_n_edges(c, SC_SIDE_B);
+    CHECK(ne >= nb - 1, "a connected graph has at least n-1 edges: %zu", ne);
+    edges = malloc((2 * ne + 1) * sizeof *edges);
+    CHECK_STATUS(sc_correspondence_edges(c, SC_SIDE_B, edges, 2 * ne), SC_STATUS_OK);
+    for (i = 0; i < ne; i++)
+        CHECK(edges[2 * i] < edges[2 * i + 1] && edges[2 * i + 1] < nb, "edge %zu", i);
+
+    CHECK_STATUS(sc_correspondence_seconds(c, "total", &total), SC_STATUS_OK);
+    CHECK_STATUS(sc_correspondence_seconds(c, "eigenbasis_a", &seconds), SC_STATUS_OK);
+    CHECK(total > 0.0 && seconds > 0.0 && seconds <= total, "timings %g of %g", seconds, total);
+    CHECK_STATUS(sc_correspondence_seconds(c, "lunch", &seconds), SC_STATUS_INVALID_ARGUMENT);
+
+    free(rgba);
+    free(rgba_b);
+    free(regions);
+    free(areas);
+    free(descriptors);
+    free(edges);
+done:
+    sc_correspondence_free(c);
+    sc_correspondence_free(NULL);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+    sc_shape_free(b_mesh);
+    free(xyz_d);
+    free(xyz_f);
+    free(tri);
+}
+
+/* A mesh against a noisy point cloud made from another pose's vertices. */
+static void test_point_cloud(void) {
+    sc_shape *a = figure("humanoid", 0), *mesh = figure("humanoid", 2), *cloud = NULL;
+    sc_correspondence *c = NULL;
+    size_t n, i;
+    double *xyz, acc;
+    unsigned seed = 12345u;
+    if (a == NULL || mesh == NULL)
+        return;
+    n = sc_shape_n_vertices(mesh);
+    xyz = malloc(3 * n * sizeof *xyz);
+    CHECK_STATUS(sc_shape_vertices(mesh, xyz, 3 * n), SC_STATUS_OK);
+    for (i = 0; i < 3 * n; i++) {
+        seed = seed * 1103515245u + 12345u;
+        xyz[i] += 0.002 * ((double)(seed >> 16 & 0x7fff) / 32767.0 - 0.5);
+    }
+    CHECK_STATUS(sc_shape_new_point_cloud(xyz, n, &cloud), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, cloud, NULL, NULL, NULL, &c), SC_STATUS_OK);
+    if (c != NULL) {
+        acc = region_accuracy(c, SC_MATCHES_SYMMETRIC);
+        printf("mesh vs point cloud: symmetric accuracy %.3f\n", acc);
+        CHECK(acc >= (quick ? 0.6 : 0.8), "mesh vs cloud accuracy %.3f", acc);
+    }
+    sc_correspondence_free(c);
+    sc_shape_free(a);
+    sc_shape_free(mesh);
+    sc_shape_free(cloud);
+    free(xyz);
+}
+
+static void test_match_errors(void) {
+    sc_shape *a = figure("star5", 0);
+    sc_params *params = NULL;
+    sc_correspondence *sentinel = (sc_correspondence *)(void *)&checks, *c = sentinel;
+    double t0;
+    CHECK_STATUS(sc_match(a, NULL, NULL, NULL, NULL, &c), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_match(NULL, a, NULL, NULL, NULL, &c), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_match(a, a, NULL, NULL, NULL, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "k_min", 8), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "k_max", 5), SC_STATUS_OK);
+    t0 = now_seconds();
+    CHECK_STATUS(sc_match(a, a, params, NULL, NULL, &c), SC_STATUS_INVALID_PARAMETER);
+    CHECK(now_seconds() - t0 < 0.5, "parameters are checked before any work");
+    CHECK(strstr(sc_last_error(), "k_min") != NULL, "message: %s", sc_last_error());
+    CHECK(c == sentinel, "no output on failure");
+    sc_params_free(params);
+    sc_shape_free(a);
+}
+
+static void test_cancellation(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 1);
+    sc_correspondence *sentinel = (sc_correspondence *)(void *)&checks, *c = sentinel;
+    sc_symmetry *s_sentinel = (sc_symmetry *)(void *)&checks, *s = s_sentinel;
+    uint32_t stage;
+    for (stage = SC_STAGE_EIGENBASIS; stage <= SC_STAGE_SYMMETRY_BREAKING; stage++) {
+        struct progress_log log = {0, 0, 0, 0, 0.0};
+        double latency;
+        if (stage == SC_STAGE_DESCRIPTORS)
+            continue; /* too short to be interesting; cancelled like the others */
+        log.cancel_at_stage = (int)stage;
+        CHECK_STATUS(sc_match(a, b, NULL, record_progress, &log, &c), SC_STATUS_CANCELLED);
+        latency = now_seconds() - log.cancelled_at;
+        CHECK(log.cancelled_at > 0.0, "stage %u was reported", stage);
+        CHECK(latency < 0.5, "stopped %.3f s after the cancel at stage %u", latency, stage);
+        CHECK(c == sentinel, "no output when cancelled");
+    }
+    {
+        struct progress_log log = {0, 0, 0, SC_STAGE_SEGMENTATION, 0.0};
+        CHECK_STATUS(sc_symmetry_detect(a, NULL, record_progress, &log, &s),
+                     SC_STATUS_CANCELLED);
+        CHECK(s == s_sentinel, "no symmetry output when cancelled");
+    }
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
+static void test_symmetry(void) {
+    sc_shape *star = figure("star5", 0);
+    sc_symmetry *s = NULL;
+    size_t nr, ng, nv, i, largest = 0;
+    uint32_t *groups, *sizes;
+    uint8_t *rgba;
+    CHECK_STATUS(sc_symmetry_detect(star, NULL, NULL, NULL, &s), SC_STATUS_OK);
+    if (s == NULL) {
+        sc_shape_free(star);
+        return;
+    }
+    nr = sc_symmetry_n_regions(s);
+    ng = sc_symmetry_n_groups(s);
+    nv = sc_symmetry_n_vertices(s);
+    CHECK(nv == sc_shape_n_vertices(star), "vertices");
+    CHECK(ng >= 1 && ng < nr, "%zu groups of %zu regions", ng, nr);
+    groups = malloc(nr * sizeof *groups);
+    sizes = calloc(ng, sizeof *sizes);
+    CHECK_STATUS(sc_symmetry_region_groups(s, groups, nr), SC_STATUS_OK);
+    for (i = 0; i < nr; i++) {
+        CHECK(groups[i] < ng, "group in range");
+        if (groups[i] < ng && ++sizes[groups[i]] > largest)
+            largest = sizes[groups[i]];
+    }
+    printf("star5 symmetry: %zu regions in %zu groups, largest group %zu\n", nr, ng, largest);
+    CHECK(largest == 5, "the five limbs form a group: largest group %zu", largest);
+    rgba = malloc(4 * nv);
+    CHECK_STATUS(sc_symmetry_colors(s, rgba, 4 * nv), SC_STATUS_OK);
+    CHECK_STATUS(sc_symmetry_colors(s, rgba, 4 * nv - 4), SC_STATUS_BUFFER_TOO_SMALL);
+    free(groups);
+    free(sizes);
+    free(rgba);
+    sc_symmetry_free(s);
+    sc_symmetry_free(NULL);
+    sc_shape_free(star);
+}
+
+/* --------------------------------------------------------------------- concurrency */
+
+struct shared_work {
+    const sc_shape *a, *b;
+    const sc_params *params;
+    const uint32_t *expected_regions_b;
+    size_t n_b;
+    int mismatches;
+    int failed;
+    int error_isolated;
+};
+
+static void *match_in_thread(void *arg) {
+    struct shared_work *work = (struct shared_work *)arg;
+    sc_correspondence *c = NULL;
+    uint32_t *regions = malloc(work->n_b * sizeof *regions);
+    sc_shape *bad = NULL;
+    /* Each thread's last error is its own. */
+    if (sc_shape_new_point_cloud(NULL, 0, &bad) != SC_STATUS_TOO_FEW_VERTICES)
+        work->failed++;
+    if (sc_match(work->a, work->b, work->params, NULL, NULL, &c) != SC_STATUS_OK) {
+        work->failed++;
+    } else {
+        if (sc_correspondence_regions(c, SC_SIDE_B, regions, work->n_b) != SC_STATUS_OK ||
+            memcmp(regions, work->expected_regions_b, work->n_b * sizeof *regions) != 0)
+            work->mismatches++;
+        sc_correspondence_free(c);
+    }
+    if (strstr(sc_last_error(), "usable vertices") == NULL)
+        work->error_isolated = 0;
+    free(regions);
+    return NULL;
+}
+
+static void test_concurrency(void) {
+    enum { MAX_THREADS = 4 };
+    int n_threads = quick ? 2 : MAX_THREADS, i;
+    sc_shape *a = figure("quadruped", 0), *b = figure("quadruped", 2);
+    sc_params *params = NULL;
+    sc_correspondence *reference = NULL;
+    pthread_t threads[MAX_THREADS];
+    struct shared_work work[MAX_THREADS];
+    uint32_t *expected;
+    size_t n_b;
+    if (a == NULL || b == NULL)
+        return;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, b, params, NULL, NULL, &reference), SC_STATUS_OK);
+    n_b = sc_shape_n_vertices(b);
+    expected = malloc(n_b * sizeof *expected);
+    CHECK_STATUS(sc_correspondence_regions(reference, SC_SIDE_B, expected, n_b), SC_STATUS_OK);
+    /* Set an error on this thread: other threads' errors must not replace it. */
+    CHECK_STATUS(sc_params_set_int(params, "no_such_option", 1), SC_STATUS_UNKNOWN_OPTION);
+    for (i = 0; i < n_threads; i++) {
+        struct shared_work w = {a, b, params, expected, n_b, 0, 0, 1};
+        work[i] = w;
+        CHECK(pthread_create(&threads[i], NULL, match_in_thread, &work[i]) == 0, "thread");
+    }
+    for (i = 0; i < n_threads; i++) {
+        pthread_join(threads[i], NULL);
+        CHECK(work[i].failed == 0, "thread %d failed", i);
+        CHECK(work[i].mismatches == 0, "thread %d: different regions than alone", i);
+        CHECK(work[i].error_isolated, "thread %d saw another thread's error", i);
+    }
+    CHECK(strstr(sc_last_error(), "no_such_option") != NULL, "main thread error kept: %s",
+          sc_last_error());
+    free(expected);
+    sc_correspondence_free(reference);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
+int main(void) {
+    const char *q = getenv("SHAPECORR_TEST_QUICK");
+    quick = q != NULL && strcmp(q, "1") == 0;
+    test_version();
+    test_status_text();
+    test_options();
+    test_shape_errors();
+    test_match_errors();
+    test_life_cycle();
+    test_point_cloud();
+    test_cancellation();
+    test_symmetry();
+    test_concurrency();
+    printf("%d checks, %d failures%s\n", checks, failures, quick ? " (quick)" : "");
+    return failures == 0 ? 0 : 1;
+}

@@ -1,0 +1,49 @@
+// The C header compiles as C++ (-Wall -Wextra -Wpedantic -Werror) and the RAII wrapper
+// works: a match through it, and an error that becomes a shapecorr::Error.
+#include <cstdio>
+#include <cstring>
+
+#include "shapecorr.hpp"
+
+int main() {
+    int failures = 0;
+    try {
+        shapecorr::Shape a = shapecorr::Shape::figure("star4", 0, 1500);
+        shapecorr::Shape b = shapecorr::Shape::figure("star4", 2, 1500);
+        shapecorr::Params params;
+        params.set("k_max", 7).set("one_to_one", true);
+        shapecorr::Correspondence c(a, b, &params);
+        std::vector<std::uint32_t> ra = c.regions(SC_SIDE_A), rb = c.regions(SC_SIDE_B);
+        auto matches = c.matches(SC_MATCHES_SYMMETRIC);
+        std::size_t good = 0;
+        for (std::size_t i = 0; i < ra.size(); i++)
+            for (auto &m : matches)
+                if (m.first == ra[i] && m.second == rb[i]) {
+                    good++;
+                    break;
+                }
+        double accuracy = double(good) / double(ra.size());
+        std::printf("C++ wrapper: k = %u, %zu matches, symmetric accuracy %.3f\n", c.k(),
+                    matches.size(), accuracy);
+        if (c.k() < 5 || c.k() > 7 || accuracy < 0.85 || c.colors(SC_SIDE_B, SC_MATCHES_ONE_TO_ONE).size() != 4 * rb.size()) {
+            std::printf("FAIL: unexpected result\n");
+            failures++;
+        }
+    } catch (const shapecorr::Error &e) {
+        std::printf("FAIL: %s\n", e.what());
+        failures++;
+    }
+    try {
+        shapecorr::Params params;
+        params.set("no_such_option", 1);
+        std::printf("FAIL: no exception for an unknown option\n");
+        failures++;
+    } catch (const shapecorr::Error &e) {
+        if (e.status() != SC_STATUS_UNKNOWN_OPTION || std::strstr(e.what(), "no_such_option") == nullptr) {
+            std::printf("FAIL: wrong error %u: %s\n", unsigned(e.status()), e.what());
+            failures++;
+        }
+    }
+    std::printf("C++ wrapper: %d failures\n", failures);
+    return failures == 0 ? 0 : 1;
+}
