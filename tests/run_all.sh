@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Runs every test of the project: the Rust unit, integration and documentation tests
 # (library, file readers, generated figures, spectral identities, region correspondence,
-# command line). The C and Python suites
-# join here when the C API lands (issue 4). Installs nothing beyond the Rust toolchain yet.
+# command line, the C header's drift check), the C API's tests (plain, AddressSanitizer +
+# UndefinedBehaviorSanitizer, valgrind; C++ wrapper; example programs) and the Python
+# binding's tests (installed with pip into target/py-venv).
+# Needs the Rust toolchain, gcc/g++ and python3; installs numpy and pytest into the venv,
+# and valgrind with apt-get if it is missing.
 # Tests that need the benchmark data (../shared/data or $SHAPECORR_DATA) skip cleanly
 # without it.
 set -euo pipefail
@@ -10,3 +13,5 @@ cd "$(dirname "$0")/.."
 cargo build --release --locked
 cargo test --release --locked --all-targets
 cargo test --release --locked --doc
+bash tests/c/run.sh
+bash tests/python/run.sh

@@ -1,0 +1,398 @@
+"""shapecorr: region-level correspondences between 3D shapes (meshes and point clouds).
+
+A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
+
+    import shapecorr
+    a = shapecorr.Shape.read("a.ply")
+    b = shapecorr.Shape.read("b.ply")
+    result = shapecorr.match(a, b, k_max=8)
+    result.regions_a            # region of every vertex of A (numpy uint32)
+    result.matches_one_to_one   # (n, 2) array of (region of A, region of B)
+    result.colors("a")          # (n_vertices, 4) RGBA bytes, matched regions share a colour
+
+Options are the library's named options (``shapecorr.options()``), with the same defaults as
+the command line. Errors raise :class:`ShapecorrError` with the C status and the message.
+Shapes and results may be shared between threads; the library releases the GIL while it
+works (ctypes does).
+"""
+
+import ctypes
+import weakref
+
+import numpy as np
+
+from . import _lib
+from ._lib import lib
+
+__all__ = [
+    "ShapecorrError",
+    "Shape",
+    "Correspondence",
+    "Symmetry",
+    "match",
+    "detect_symmetry",
+    "options",
+    "version",
+]
+
+
+class ShapecorrError(Exception):
+    """A failed call: ``status`` is the C status code, ``status_name`` its name (e.g.
+    ``"NON_FINITE_COORDINATE"``), ``message`` the library's explanation."""
+
+    def __init__(self, status, message):
+        self.status = int(status)
+        self.status_name = _lib.STATUS_NAMES.get(self.status, "UNKNOWN")
+        self.message = message
+        super().__init__(f"{self.status_name}: {message}")
+
+
+def _check(status):
+    if status != 0:
+        message = lib.sc_last_error().decode("utf-8", "replace")
+        raise ShapecorrError(status, message)
+
+
+def version():
+    """The library's version string (the same as ``__version__``)."""
+    return lib.sc_version().decode()
+
+
+__version__ = version()
+
+
+def _ptr(array, ctype):
+    return array.ctypes.data_as(ctypes.POINTER(ctype))
+
+
+def _fill(function, handle, *args, shape, dtype, ctype):
+    """Allocates a numpy array and lets ``function(handle, *args, out, len)`` fill it."""
+    out = np.empty(shape, dtype=dtype)
+    _check(function(handle, *args, _ptr(out, ctype), out.size))
+    return out
+
+
+class _Handle:
+    """Owns a C handle; freed when the object is collected or at interpreter exit."""
+
+    _free = None
+
+    def __init__(self, pointer):
+        self._as_parameter_ = ctypes.c_void_p(pointer)
+        # finalize keeps a reference to the free function, so it works at exit too.
+        self._finalizer = weakref.finalize(self, type(self)._free, pointer)
+
+    def close(self):
+        """Frees the C object now (also done automatically)."""
+        self._finalizer()
+
+
+def _new_handle(constructor, *args):
+    out = ctypes.c_void_p()
+    _check(constructor(*args, ctypes.byref(out)))
+    return out.value
+
+
+class Shape(_Handle):
+    """A validated triangle mesh or point cloud (immutable; safe to share between
+    threads). Make one with :meth:`mesh`, :meth:`point_cloud`, :meth:`read` or
+    :meth:`figure`."""
+
+    _free = lib.sc_shape_free
+
+    @classmethod
+    def mesh(cls, vertices, triangles):
+        """A mesh from an (n, 3) array of vertices and an (m, 3) array of 0-based triangle
+        indices (copied; float32 coordinates stay float32 on the way in)."""
+        vertices = np.asarray(vertices)
+        coords, function, ctype = _coordinates(vertices, lib.sc_shape_new_mesh_f32, lib.sc_shape_new_mesh)
+        tris = np.asarray(triangles)
+        if tris.size and (tris.ndim != 2 or tris.shape[1] != 3):
+            raise ValueError(f"triangles must have shape (m, 3), got {tris.shape}")
+        if tris.size and (tris.min() < 0 or tris.max() > np.iinfo(np.uint32).max):
+            bad = tris.min() if tris.min() < 0 else tris.max()
+            raise ShapecorrError(
+                11, f"triangle index {bad} is out of range for {len(coords)} vertices"
+            )
+        tris = np.ascontiguousarray(tris, dtype=np.uint32).reshape(-1, 3)
+        return cls(
+            _new_handle(
+                function, _ptr(coords, ctype), len(coords), _ptr(tris, ctypes.c_uint32), len(tris)
+            )
+        )
+
+    @classmethod
+    def point_cloud(cls, points):
+        """A point cloud from an (n, 3) array of points (copied)."""
+        coords, function, ctype = _coordinates(
+            np.asarray(points), lib.sc_shape_new_point_cloud_f32, lib.sc_shape_new_point_cloud
+        )
+        return cls(_new_handle(function, _ptr(coords, ctype), len(coords)))
+
+    @classmethod
+    def read(cls, path, as_point_cloud=False):
+        """Reads OFF, OBJ, PLY or XYZ; a file without faces gives a point cloud."""
+        return cls(_new_handle(lib.sc_shape_read, str(path).encode(), bool(as_point_cloud)))
+
+    @classmethod
+    def figure(cls, kind="humanoid", pose=0, vertices=5000):
+        """A generated figure (``"humanoid"``, ``"quadruped"``, ``"star3"``..``"star8"``);
+        every pose of a kind and size shares the vertex order (a ground truth)."""
+        return cls(_new_handle(lib.sc_shape_new_figure, kind.encode(), int(pose), int(vertices)))
+
+    @property
+    def n_vertices(self):
+        return lib.sc_shape_n_vertices(self)
+
+    @property
+    def is_point_cloud(self):
+        return bool(lib.sc_shape_is_point_cloud(self))
+
+    @property
+    def vertices(self):
+        """(n, 3) float64 array of the vertices, in the input order."""
+        return _fill(
+            lib.sc_shape_vertices, self, shape=(self.n_vertices, 3), dtype=np.float64,
+            ctype=ctypes.c_double,
+        )
+
+    @property
+    def triangles(self):
+        """(m, 3) uint32 array of triangles (polygons split; empty for a point cloud)."""
+        n = lib.sc_shape_n_triangles(self)
+        return _fill(lib.sc_shape_triangles, self, shape=(n, 3), dtype=np.uint32, ctype=ctypes.c_uint32)
+
+    @property
+    def warnings(self):
+        """What was repaired or is unusual (degenerate faces, pieces, ...), one string each."""
+        n = lib.sc_shape_warnings(self, None, 0)
+        buf = ctypes.create_string_buffer(n + 1)
+        lib.sc_shape_warnings(self, buf, n + 1)
+        return [line for line in buf.value.decode().split("\n") if line]
+
+    def __repr__(self):
+        kind = "point cloud" if self.is_point_cloud else "mesh"
+        return f"<shapecorr.Shape {kind}, {self.n_vertices} vertices>"
+
+
+def _coordinates(array, f32_function, f64_function):
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"coordinates must have shape (n, 3), got {array.shape}")
+    if array.dtype == np.float32:
+        return np.ascontiguousarray(array), f32_function, ctypes.c_float
+    return np.ascontiguousarray(array, dtype=np.float64), f64_function, ctypes.c_double
+
+
+class _Params(_Handle):
+    _free = lib.sc_params_free
+
+    def __init__(self, values):
+        super().__init__(_new_handle(lib.sc_params_new))
+        types = {name: kind for name, kind, _, _ in options()}
+        for name, value in values.items():
+            kind = types.get(name)
+            if kind is None:
+                # Let the library produce its message (it lists the options).
+                _check(lib.sc_params_set_int(self, name.encode(), 0))
+            setter = {
+                "int": lib.sc_params_set_int,
+                "float": lib.sc_params_set_double,
+                "bool": lib.sc_params_set_bool,
+            }[kind]
+            if kind == "int" and (isinstance(value, bool) or int(value) != value):
+                raise ShapecorrError(2, f"option `{name}` takes an integer, got {value!r}")
+            if kind == "bool" and not isinstance(value, (bool, np.bool_)):
+                raise ShapecorrError(2, f"option `{name}` takes True or False, got {value!r}")
+            converted = {"int": int, "float": float, "bool": bool}[kind](value)
+            _check(setter(self, name.encode(), converted))
+
+
+def options():
+    """Every option as ``(name, type, description, default)``; type is ``"int"``,
+    ``"float"`` or ``"bool"``. The defaults are the library's (the same everywhere)."""
+    defaults = ctypes.c_void_p()
+    _check(lib.sc_params_new(ctypes.byref(defaults)))
+    try:
+        result = []
+        for i in range(lib.sc_option_count()):
+            name = lib.sc_option_name(i)
+            kind = {0: "int", 1: "float", 2: "bool"}[lib.sc_option_type(i)]
+            value = {"int": ctypes.c_int64, "float": ctypes.c_double, "bool": ctypes.c_bool}[kind]()
+            getter = {
+                "int": lib.sc_params_get_int,
+                "float": lib.sc_params_get_double,
+                "bool": lib.sc_params_get_bool,
+            }[kind]
+            _check(getter(defaults, name, ctypes.byref(value)))
+            result.append((name.decode(), kind, lib.sc_option_doc(i).decode(), value.value))
+        return result
+    finally:
+        lib.sc_params_free(defaults)
+
+
+class _Progress:
+    """Wraps a Python callable ``progress(stage_name, fraction) -> bool`` (returning False
+    cancels); an exception inside it cancels the call and is raised afterwards."""
+
+    def __init__(self, progress):
+        self.error = None
+        self.user = progress
+
+        def call(_userdata, stage, fraction):
+            try:
+                keep_going = self.user(_lib.STAGE_NAMES.get(stage, str(stage)), float(fraction))
+                return keep_going is not False
+            except BaseException as error:  # noqa: BLE001 - re-raised after the C call
+                self.error = error
+                return False
+
+        self.c_function = _lib.PROGRESS(call) if progress is not None else _lib.PROGRESS()
+
+    def finish(self, status):
+        if self.error is not None:
+            raise self.error
+        _check(status)
+
+
+def _side(side):
+    if side in ("a", "A", 0):
+        return _lib.SIDE_A
+    if side in ("b", "B", 1):
+        return _lib.SIDE_B
+    raise ValueError(f"side must be 'a' or 'b', got {side!r}")
+
+
+class Correspondence(_Handle):
+    """The result of :func:`match` (immutable; safe to share between threads)."""
+
+    _free = lib.sc_correspondence_free
+
+    @property
+    def k(self):
+        """The number of joint clusters chosen."""
+        return lib.sc_correspondence_k(self)
+
+    def n_regions(self, side):
+        return lib.sc_correspondence_n_regions(self, _side(side))
+
+    def regions(self, side):
+        """Region id of every vertex of one side (``"a"`` or ``"b"``), input order."""
+        s = _side(side)
+        n = lib.sc_correspondence_n_vertices(self, s)
+        return _fill(lib.sc_correspondence_regions, self, s, shape=n, dtype=np.uint32, ctype=ctypes.c_uint32)
+
+    @property
+    def regions_a(self):
+        return self.regions("a")
+
+    @property
+    def regions_b(self):
+        return self.regions("b")
+
+    def _matches(self, kind):
+        n = lib.sc_correspondence_n_matches(self, kind)
+        return _fill(
+            lib.sc_correspondence_matches, self, kind, shape=(n, 2), dtype=np.uint32,
+            ctype=ctypes.c_uint32,
+        )
+
+    @property
+    def matches(self):
+        """Symmetric matches: (n, 2) array of (region of A, region of B)."""
+        return self._matches(_lib.MATCHES_SYMMETRIC)
+
+    @property
+    def matches_one_to_one(self):
+        """One-to-one matches after symmetry breaking (empty if ``one_to_one=False``)."""
+        return self._matches(_lib.MATCHES_ONE_TO_ONE)
+
+    def colors(self, side, one_to_one=True):
+        """(n_vertices, 4) uint8 RGBA of one side: matched regions share a colour on both
+        shapes, unmatched regions are dark grey."""
+        s = _side(side)
+        kind = _lib.MATCHES_ONE_TO_ONE if one_to_one else _lib.MATCHES_SYMMETRIC
+        n = lib.sc_correspondence_n_vertices(self, s)
+        return _fill(lib.sc_correspondence_colors, self, s, kind, shape=(n, 4), dtype=np.uint8, ctype=ctypes.c_uint8)
+
+    def graph(self, side):
+        """One side's shape graph: ``areas`` (fraction of the shape's area per region),
+        ``descriptors`` (mean HKS per region) and ``edges`` ((e, 2) array, regions that
+        touch)."""
+        s = _side(side)
+        n = lib.sc_correspondence_n_regions(self, s)
+        dim = lib.sc_correspondence_descriptor_length(self)
+        e = lib.sc_correspondence_n_edges(self, s)
+        return {
+            "areas": _fill(lib.sc_correspondence_region_areas, self, s, shape=n, dtype=np.float64, ctype=ctypes.c_double),
+            "descriptors": _fill(
+                lib.sc_correspondence_region_descriptors, self, s, shape=(n, dim), dtype=np.float64,
+                ctype=ctypes.c_double,
+            ),
+            "edges": _fill(lib.sc_correspondence_edges, self, s, shape=(e, 2), dtype=np.uint32, ctype=ctypes.c_uint32),
+        }
+
+    @property
+    def timings(self):
+        """Seconds per stage, and ``total``."""
+        out = {}
+        for stage in (
+            "eigenbasis_a", "eigenbasis_b", "descriptors", "segmentation", "matching",
+            "one_to_one", "total",
+        ):
+            value = ctypes.c_double()
+            _check(lib.sc_correspondence_seconds(self, stage.encode(), ctypes.byref(value)))
+            out[stage] = value.value
+        return out
+
+
+class Symmetry(_Handle):
+    """The result of :func:`detect_symmetry` (immutable)."""
+
+    _free = lib.sc_symmetry_free
+
+    @property
+    def regions(self):
+        n = lib.sc_symmetry_n_vertices(self)
+        return _fill(lib.sc_symmetry_regions, self, shape=n, dtype=np.uint32, ctype=ctypes.c_uint32)
+
+    @property
+    def region_groups(self):
+        """Group of every region: regions of one group are symmetric copies."""
+        n = lib.sc_symmetry_n_regions(self)
+        return _fill(lib.sc_symmetry_region_groups, self, shape=n, dtype=np.uint32, ctype=ctypes.c_uint32)
+
+    @property
+    def groups(self):
+        """List of groups, each a sorted list of regions."""
+        groups = [[] for _ in range(lib.sc_symmetry_n_groups(self))]
+        for region, group in enumerate(self.region_groups):
+            groups[group].append(region)
+        return groups
+
+    def colors(self):
+        """(n_vertices, 4) uint8 RGBA: a symmetric group shares a colour, others dark grey."""
+        n = lib.sc_symmetry_n_vertices(self)
+        return _fill(lib.sc_symmetry_colors, self, shape=(n, 4), dtype=np.uint8, ctype=ctypes.c_uint8)
+
+
+def match(a, b, progress=None, **options):
+    """Region correspondence between shapes ``a`` and ``b``. ``options`` are named options
+    (``k_min=5, k_max=10, one_to_one=True, ...``; see :func:`options`). ``progress``, if
+    given, is called as ``progress(stage, fraction)`` and cancels by returning False
+    (:class:`ShapecorrError` with status ``CANCELLED``)."""
+    params = _Params(options)
+    callback = _Progress(progress)
+    out = ctypes.c_void_p()
+    status = lib.sc_match(a, b, params, callback.c_function, None, ctypes.byref(out))
+    callback.finish(status)
+    return Correspondence(out.value)
+
+
+def detect_symmetry(shape, progress=None, **options):
+    """Groups of mutually symmetric regions of one shape (arguments as :func:`match`)."""
+    params = _Params(options)
+    callback = _Progress(progress)
+    out = ctypes.c_void_p()
+    status = lib.sc_symmetry_detect(shape, params, callback.c_function, None, ctypes.byref(out))
+    callback.finish(status)
+    return Symmetry(out.value)

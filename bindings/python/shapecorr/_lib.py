@@ -1,0 +1,174 @@
+"""The one loader of libshapecorr and the ctypes declarations of every C function.
+
+Where the library comes from, in order:
+1. the file named by the environment variable ``SHAPECORR_LIB``;
+2. the copy packaged inside this Python package (``pip install ./bindings/python``);
+3. ``target/release`` of the repository this package sits in (a development checkout).
+"""
+
+import ctypes
+import os
+import sys
+from pathlib import Path
+
+#: The C ABI version this binding was written for (``SC_ABI_VERSION`` in shapecorr.h).
+ABI_VERSION = 1
+
+_NAMES = {"linux": "libshapecorr.so", "darwin": "libshapecorr.dylib", "win32": "shapecorr.dll"}
+LIBRARY_NAME = _NAMES.get(sys.platform, "libshapecorr.so")
+
+
+def _candidates():
+    override = os.environ.get("SHAPECORR_LIB")
+    if override:
+        return [("SHAPECORR_LIB", Path(override))]
+    here = Path(__file__).resolve().parent
+    return [
+        ("packaged copy", here / LIBRARY_NAME),
+        ("development checkout", here.parents[2] / "target" / "release" / LIBRARY_NAME),
+    ]
+
+
+def _load():
+    tried = []
+    for origin, path in _candidates():
+        if path.is_file():
+            try:
+                return ctypes.CDLL(str(path)), path
+            except OSError as error:
+                tried.append(f"{path} ({origin}): {error}")
+                if origin == "SHAPECORR_LIB":
+                    break
+        else:
+            tried.append(f"{path} ({origin}): no such file")
+            if origin == "SHAPECORR_LIB":
+                break
+    raise ImportError(
+        "shapecorr: cannot load the shared library; tried "
+        + "; ".join(tried)
+        + ". Build it with `cargo build --release`, install the package with "
+        "`pip install ./bindings/python`, or set SHAPECORR_LIB to the library's path."
+    )
+
+
+lib, LIBRARY_PATH = _load()
+
+c_size_t = ctypes.c_size_t
+c_u32 = ctypes.c_uint32
+c_u8p = ctypes.POINTER(ctypes.c_uint8)
+c_u32p = ctypes.POINTER(ctypes.c_uint32)
+c_f64p = ctypes.POINTER(ctypes.c_double)
+c_f32p = ctypes.POINTER(ctypes.c_float)
+c_i64p = ctypes.POINTER(ctypes.c_int64)
+c_boolp = ctypes.POINTER(ctypes.c_bool)
+c_str = ctypes.c_char_p
+handle = ctypes.c_void_p
+handle_out = ctypes.POINTER(ctypes.c_void_p)
+status = ctypes.c_uint32
+
+#: ``bool (*)(void *userdata, uint32_t stage, float fraction)``
+PROGRESS = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float)
+
+#: Every exported function: name -> (restype, argtypes). tests check it against the header.
+FUNCTIONS = {
+    "sc_version": (c_str, []),
+    "sc_version_major": (c_u32, []),
+    "sc_version_minor": (c_u32, []),
+    "sc_version_patch": (c_u32, []),
+    "sc_abi_version": (c_u32, []),
+    "sc_status_str": (c_str, [c_u32]),
+    "sc_last_error": (c_str, []),
+    # shapes
+    "sc_shape_new_mesh": (status, [c_f64p, c_size_t, c_u32p, c_size_t, handle_out]),
+    "sc_shape_new_mesh_f32": (status, [c_f32p, c_size_t, c_u32p, c_size_t, handle_out]),
+    "sc_shape_new_point_cloud": (status, [c_f64p, c_size_t, handle_out]),
+    "sc_shape_new_point_cloud_f32": (status, [c_f32p, c_size_t, handle_out]),
+    "sc_shape_read": (status, [c_str, ctypes.c_bool, handle_out]),
+    "sc_shape_new_figure": (status, [c_str, c_u32, c_u32, handle_out]),
+    "sc_shape_free": (None, [handle]),
+    "sc_shape_n_vertices": (c_size_t, [handle]),
+    "sc_shape_n_triangles": (c_size_t, [handle]),
+    "sc_shape_is_point_cloud": (ctypes.c_bool, [handle]),
+    "sc_shape_vertices": (status, [handle, c_f64p, c_size_t]),
+    "sc_shape_triangles": (status, [handle, c_u32p, c_size_t]),
+    "sc_shape_warnings": (c_size_t, [handle, ctypes.c_char_p, c_size_t]),
+    # parameters
+    "sc_params_new": (status, [handle_out]),
+    "sc_params_free": (None, [handle]),
+    "sc_params_set_int": (status, [handle, c_str, ctypes.c_int64]),
+    "sc_params_set_double": (status, [handle, c_str, ctypes.c_double]),
+    "sc_params_set_bool": (status, [handle, c_str, ctypes.c_bool]),
+    "sc_params_get_int": (status, [handle, c_str, c_i64p]),
+    "sc_params_get_double": (status, [handle, c_str, c_f64p]),
+    "sc_params_get_bool": (status, [handle, c_str, c_boolp]),
+    "sc_option_count": (c_size_t, []),
+    "sc_option_name": (c_str, [c_size_t]),
+    "sc_option_doc": (c_str, [c_size_t]),
+    "sc_option_type": (c_u32, [c_size_t]),
+    # correspondence
+    "sc_match": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
+    "sc_correspondence_free": (None, [handle]),
+    "sc_correspondence_k": (c_u32, [handle]),
+    "sc_correspondence_n_vertices": (c_size_t, [handle, c_u32]),
+    "sc_correspondence_n_regions": (c_size_t, [handle, c_u32]),
+    "sc_correspondence_regions": (status, [handle, c_u32, c_u32p, c_size_t]),
+    "sc_correspondence_n_matches": (c_size_t, [handle, c_u32]),
+    "sc_correspondence_matches": (status, [handle, c_u32, c_u32p, c_size_t]),
+    "sc_correspondence_colors": (status, [handle, c_u32, c_u32, c_u8p, c_size_t]),
+    "sc_correspondence_descriptor_length": (c_size_t, [handle]),
+    "sc_correspondence_region_areas": (status, [handle, c_u32, c_f64p, c_size_t]),
+    "sc_correspondence_region_descriptors": (status, [handle, c_u32, c_f64p, c_size_t]),
+    "sc_correspondence_n_edges": (c_size_t, [handle, c_u32]),
+    "sc_correspondence_edges": (status, [handle, c_u32, c_u32p, c_size_t]),
+    "sc_correspondence_seconds": (status, [handle, c_str, c_f64p]),
+    # symmetry
+    "sc_symmetry_detect": (status, [handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
+    "sc_symmetry_free": (None, [handle]),
+    "sc_symmetry_n_vertices": (c_size_t, [handle]),
+    "sc_symmetry_n_regions": (c_size_t, [handle]),
+    "sc_symmetry_n_groups": (c_size_t, [handle]),
+    "sc_symmetry_regions": (status, [handle, c_u32p, c_size_t]),
+    "sc_symmetry_region_groups": (status, [handle, c_u32p, c_size_t]),
+    "sc_symmetry_colors": (status, [handle, c_u8p, c_size_t]),
+}
+
+for _name, (_restype, _argtypes) in FUNCTIONS.items():
+    _function = getattr(lib, _name)
+    _function.restype = _restype
+    _function.argtypes = _argtypes
+
+if lib.sc_abi_version() != ABI_VERSION:
+    raise ImportError(
+        f"shapecorr: {LIBRARY_PATH} has C ABI version {lib.sc_abi_version()}, this binding "
+        f"needs {ABI_VERSION}; rebuild the library or reinstall the package"
+    )
+
+# Constants of shapecorr.h.
+SIDE_A, SIDE_B = 0, 1
+MATCHES_SYMMETRIC, MATCHES_ONE_TO_ONE = 0, 1
+OPTION_INT, OPTION_DOUBLE, OPTION_BOOL = 0, 1, 2
+STATUS_NAMES = {
+    0: "OK",
+    1: "NULL_ARGUMENT",
+    2: "INVALID_ARGUMENT",
+    3: "BUFFER_TOO_SMALL",
+    4: "UNKNOWN_OPTION",
+    10: "NON_FINITE_COORDINATE",
+    11: "FACE_INDEX_OUT_OF_RANGE",
+    12: "FACE_TOO_SMALL",
+    13: "TOO_FEW_VERTICES",
+    14: "ZERO_AREA",
+    15: "INVALID_PARAMETER",
+    16: "FILE_ERROR",
+    17: "NUMERICAL_FAILURE",
+    18: "CANCELLED",
+    100: "PANIC",
+}
+STAGE_NAMES = {
+    1: "laplacian",
+    2: "eigenbasis",
+    3: "descriptors",
+    4: "segmentation",
+    5: "matching",
+    6: "symmetry_breaking",
+}

@@ -1,0 +1,305 @@
+"""The Python binding against the real library: the same cases as tests/c/test_api.c
+(life cycle, every error path, cancellation, threads, versions), plus the loader, freeing at
+interpreter exit and the README's Python example."""
+
+import ctypes
+import math
+import os
+import re
+import subprocess
+import sys
+import textwrap
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import shapecorr
+from shapecorr import ShapecorrError, _lib
+
+REPOSITORY = Path(__file__).resolve().parents[3]
+SIZE = 2500
+
+
+@pytest.fixture(scope="module")
+def humanoids():
+    return shapecorr.Shape.figure("humanoid", 0, SIZE), shapecorr.Shape.figure("humanoid", 3, SIZE)
+
+
+def symmetric_accuracy(result, matches):
+    """Fraction of vertices (shared vertex order) whose two regions are matched."""
+    pairs = {tuple(m) for m in matches.tolist()}
+    ra, rb = result.regions_a, result.regions_b
+    return float(np.mean([(int(x), int(y)) in pairs for x, y in zip(ra, rb)]))
+
+
+# ------------------------------------------------------------------------ versions, loader
+
+
+def test_versions_agree_everywhere():
+    cargo = re.search(r'^version = "(.*)"$', (REPOSITORY / "Cargo.toml").read_text(), re.M)
+    pyproject = re.search(
+        r'^version = "(.*)"$', (REPOSITORY / "bindings/python/pyproject.toml").read_text(), re.M
+    )
+    assert shapecorr.__version__ == shapecorr.version() == cargo.group(1) == pyproject.group(1)
+    major, minor, patch = (int(x) for x in cargo.group(1).split("."))
+    assert (_lib.lib.sc_version_major(), _lib.lib.sc_version_minor(), _lib.lib.sc_version_patch()) == (
+        major,
+        minor,
+        patch,
+    )
+    assert _lib.lib.sc_abi_version() == _lib.ABI_VERSION
+
+
+def test_every_header_function_is_declared_and_nothing_else():
+    header = (REPOSITORY / "include" / "shapecorr.h").read_text()
+    declared_in_header = set(re.findall(r"\b(sc_[a-z0-9_]+)\(", header))
+    # Names that appear followed by "(" only inside comments are not functions.
+    functions = {
+        name
+        for name in declared_in_header
+        if re.search(rf"^[A-Za-z0-9_ ]+[ *]{name}\(", header, re.M)
+    }
+    assert functions == set(_lib.FUNCTIONS)
+
+
+def test_status_names_match_the_header():
+    header = (REPOSITORY / "include" / "shapecorr.h").read_text()
+    in_header = {int(v): n for n, v in re.findall(r"SC_STATUS_([A-Z_]+) = (\d+)", header)}
+    assert in_header == _lib.STATUS_NAMES
+
+
+def test_installed_package_uses_its_packaged_library():
+    if os.environ.get("SHAPECORR_EXPECT_PACKAGED") != "1":
+        pytest.skip("only when testing an installed package (tests/run_all.sh sets this)")
+    assert "site-packages" in shapecorr.__file__
+    assert _lib.LIBRARY_PATH.parent == Path(shapecorr.__file__).resolve().parent
+
+
+def run_python(code, **env):
+    return subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **env},
+        timeout=120,
+    )
+
+
+def test_shapecorr_lib_overrides_the_loader():
+    library = REPOSITORY / "target" / "release" / _lib.LIBRARY_NAME
+    done = run_python(
+        "import shapecorr._lib as l; print(l.LIBRARY_PATH)", SHAPECORR_LIB=str(library)
+    )
+    assert done.returncode == 0, done.stderr
+    assert Path(done.stdout.strip()) == library
+    missing = run_python("import shapecorr", SHAPECORR_LIB="/nonexistent/libshapecorr.so")
+    assert missing.returncode != 0
+    assert "SHAPECORR_LIB" in missing.stderr and "/nonexistent/libshapecorr.so" in missing.stderr
+
+
+def test_objects_alive_at_interpreter_exit_are_freed_cleanly():
+    done = run_python(
+        """
+        import shapecorr
+        a = shapecorr.Shape.figure("star4", 0, 800)
+        b = shapecorr.Shape.figure("star4", 1, 800)
+        keep = [a, b, shapecorr.match(a, b, k_max=6), shapecorr.detect_symmetry(a, k_max=6)]
+        a.close(); a.close()   # closing twice is harmless
+        print("ok")
+        """
+    )
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr
+    assert done.stderr == ""
+
+
+# --------------------------------------------------------------------------------- options
+
+
+def test_options_and_defaults():
+    table = {name: (kind, default) for name, kind, doc, default in shapecorr.options()}
+    assert table["k_min"] == ("int", 5)
+    assert table["k_max"] == ("int", 10)
+    assert table["gap_ratio"] == ("float", 0.9)
+    assert table["one_to_one"] == ("bool", True)
+    assert len(table) == _lib.lib.sc_option_count()
+
+
+def test_option_errors(humanoids):
+    a, b = humanoids
+    with pytest.raises(ShapecorrError) as error:
+        shapecorr.match(a, b, k_mni=3)
+    assert error.value.status_name == "UNKNOWN_OPTION"
+    assert "k_mni" in error.value.message and "k_min" in error.value.message
+    for bad in [dict(k_min=2.5), dict(k_min=True), dict(one_to_one=1)]:
+        with pytest.raises(ShapecorrError) as error:
+            shapecorr.match(a, b, **bad)
+        assert error.value.status_name == "INVALID_ARGUMENT", bad
+    for bad in [dict(k_min=-1), dict(gap_ratio=math.nan), dict(k_min=8, k_max=5)]:
+        with pytest.raises(ShapecorrError) as error:
+            shapecorr.match(a, b, **bad)
+        assert error.value.status_name == "INVALID_PARAMETER", bad
+
+
+# ---------------------------------------------------------------------------- bad shapes
+
+
+def sphere_points(n=40):
+    i = np.arange(n)
+    z = -1 + (2 * i + 1) / n
+    r = np.sqrt(1 - z * z)
+    return np.stack([r * np.cos(2.4 * i), r * np.sin(2.4 * i), z], axis=1)
+
+
+@pytest.mark.parametrize(
+    "make, status",
+    [
+        (lambda p: shapecorr.Shape.point_cloud(np.where(np.arange(120).reshape(40, 3) == 7, np.nan, p)), "NON_FINITE_COORDINATE"),
+        (lambda p: shapecorr.Shape.point_cloud(np.where(np.arange(120).reshape(40, 3) == 7, np.inf, p)), "NON_FINITE_COORDINATE"),
+        (lambda p: shapecorr.Shape.mesh(p, [[0, 1, 40]]), "FACE_INDEX_OUT_OF_RANGE"),
+        (lambda p: shapecorr.Shape.mesh(p, [[0, 1, -1]]), "FACE_INDEX_OUT_OF_RANGE"),
+        (lambda p: shapecorr.Shape.mesh(np.zeros((0, 3)), np.zeros((0, 3))), "TOO_FEW_VERTICES"),
+        (lambda p: shapecorr.Shape.point_cloud(p[:10]), "TOO_FEW_VERTICES"),
+        (lambda p: shapecorr.Shape.mesh(p, np.zeros((0, 3))), "ZERO_AREA"),
+        (lambda p: shapecorr.Shape.read("/nonexistent/shape.ply"), "FILE_ERROR"),
+        (lambda p: shapecorr.Shape.figure("dragon"), "INVALID_ARGUMENT"),
+        (lambda p: shapecorr.Shape.figure("humanoid", pose=99, vertices=1000), "INVALID_PARAMETER"),
+    ],
+)
+def test_bad_shapes_raise_with_status_and_message(make, status):
+    with pytest.raises(ShapecorrError) as error:
+        make(sphere_points())
+    assert error.value.status_name == status
+    assert error.value.message
+
+
+def test_malformed_file(tmp_path):
+    path = tmp_path / "bad.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1 2\n")
+    with pytest.raises(ShapecorrError) as error:
+        shapecorr.Shape.read(path)
+    assert error.value.status_name == "FILE_ERROR" and "bad.ply" in error.value.message
+
+
+def test_wrong_array_shapes_are_value_errors():
+    with pytest.raises(ValueError):
+        shapecorr.Shape.point_cloud(np.zeros((40, 2)))
+    with pytest.raises(ValueError):
+        shapecorr.Shape.mesh(sphere_points(), [0, 1, 2, 3])
+
+
+def test_raw_api_null_and_buffer_errors(humanoids):
+    lib = _lib.lib
+    a, b = humanoids
+    assert lib.sc_shape_n_vertices(None) == 0
+    out = ctypes.c_void_p()
+    assert lib.sc_match(None, b, None, _lib.PROGRESS(), None, ctypes.byref(out)) == 1
+    assert lib.sc_match(a, b, None, _lib.PROGRESS(), None, None) == 1
+    assert "out_correspondence" in lib.sc_last_error().decode()
+    n = a.n_vertices
+    buffer = np.full(3 * n, -1.0)
+    status = lib.sc_shape_vertices(a, buffer.ctypes.data_as(_lib.c_f64p), 3 * n - 1)
+    assert _lib.STATUS_NAMES[status] == "BUFFER_TOO_SMALL"
+    assert np.all(buffer == -1.0), "nothing written on failure"
+    assert lib.sc_shape_vertices(a, None, 3 * n) == 1
+
+
+# ----------------------------------------------------------------------------- life cycle
+
+
+def test_life_cycle(humanoids):
+    a, b = humanoids
+    stages = []
+    result = shapecorr.match(a, b, progress=lambda stage, f: stages.append((stage, f)) or True)
+    assert {s for s, _ in stages} >= {"eigenbasis", "segmentation", "matching"}
+    assert all(0.0 <= f <= 1.0 for _, f in stages)
+    assert 5 <= result.k <= 10
+    assert result.regions_a.shape == (a.n_vertices,) and result.regions_a.dtype == np.uint32
+    sym = symmetric_accuracy(result, result.matches)
+    assert sym >= 0.9, sym
+    one = result.matches_one_to_one
+    assert set(map(tuple, one.tolist())) <= set(map(tuple, result.matches.tolist()))
+    colors_a, colors_b = result.colors("a"), result.colors("b")
+    assert colors_a.shape == (a.n_vertices, 4) and np.all(colors_b[:, 3] == 255)
+    pairs = {tuple(m) for m in one.tolist()}
+    in_one = np.array([(int(x), int(y)) in pairs for x, y in zip(result.regions_a, result.regions_b)])
+    assert np.all(colors_a[in_one] == colors_b[in_one])
+    graph = result.graph("b")
+    assert abs(graph["areas"].sum() - 1.0) < 1e-9
+    assert graph["descriptors"].shape == (result.n_regions("b"), 15)
+    assert np.all(graph["edges"][:, 0] < graph["edges"][:, 1])
+    timings = result.timings
+    assert 0 < timings["eigenbasis_a"] <= timings["total"]
+
+
+def test_vertices_round_trip_and_float32_input(humanoids):
+    a, _ = humanoids
+    v, t = a.vertices, a.triangles
+    copy = shapecorr.Shape.mesh(v.astype(np.float32), t)
+    assert copy.n_vertices == a.n_vertices
+    assert np.allclose(copy.vertices, v, atol=1e-6)
+    assert np.array_equal(copy.triangles, t)
+    assert not copy.is_point_cloud and copy.warnings == []
+
+
+def test_mesh_against_noisy_point_cloud(humanoids):
+    a, b = humanoids
+    rng = np.random.default_rng(7)
+    cloud = shapecorr.Shape.point_cloud(b.vertices + rng.uniform(-0.001, 0.001, (b.n_vertices, 3)))
+    assert cloud.is_point_cloud
+    result = shapecorr.match(a, cloud)
+    assert symmetric_accuracy(result, result.matches) >= 0.8
+
+
+def test_cancellation_and_exceptions_in_the_callback(humanoids):
+    a, b = humanoids
+    with pytest.raises(ShapecorrError) as error:
+        shapecorr.match(a, b, progress=lambda stage, f: stage != "segmentation")
+    assert error.value.status_name == "CANCELLED"
+
+    def broken(stage, fraction):
+        raise ZeroDivisionError("from the callback")
+
+    with pytest.raises(ZeroDivisionError, match="from the callback"):
+        shapecorr.match(a, b, progress=broken)
+
+
+def test_concurrent_matches_on_shared_shapes_give_the_same_answer(humanoids):
+    a, b = humanoids
+    reference = shapecorr.match(a, b)
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        results = list(pool.map(lambda _: shapecorr.match(a, b), range(4)))
+    for r in results:
+        assert np.array_equal(r.regions_a, reference.regions_a)
+        assert np.array_equal(r.matches_one_to_one, reference.matches_one_to_one)
+
+
+def test_symmetry_detection_on_a_star():
+    star = shapecorr.Shape.figure("star5", 0, SIZE)
+    symmetry = shapecorr.detect_symmetry(star)
+    sizes = [len(g) for g in symmetry.groups]
+    assert max(sizes) == 5, sizes
+    assert sum(sizes) == len(symmetry.region_groups)
+    assert symmetry.regions.shape == (star.n_vertices,)
+    assert symmetry.colors().shape == (star.n_vertices, 4)
+
+
+def test_readme_python_example(tmp_path):
+    readme = (REPOSITORY / "README.md").read_text()
+    match = re.search(r"<!-- readme-python-example -->\s*```python\n(.*?)```", readme, re.S)
+    assert match, "README.md has no Python example after the marker"
+    code = match.group(1)
+    assert len(code.strip().splitlines()) <= 12
+    cli = REPOSITORY / "target" / "release" / "shapecorr"
+    for name, pose in [("a.ply", 0), ("b.ply", 4)]:
+        subprocess.run(
+            [str(cli), "synth", "--pose", str(pose), "--vertices", "3000", "--out", str(tmp_path / name)],
+            check=True,
+            capture_output=True,
+        )
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    assert "region 0 of A" in done.stdout, done.stdout
