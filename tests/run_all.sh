@@ -3,9 +3,10 @@
 # (library, file readers, generated figures, spectral identities, region correspondence,
 # command line, the C header's drift check), the C API's tests (plain, AddressSanitizer +
 # UndefinedBehaviorSanitizer, valgrind; C++ wrapper; example programs) and the Python
-# binding's tests (installed with pip into target/py-venv).
+# binding's tests (installed with pip into target/py-venv), and the Blender extension and
+# MeshLab script headless (bpy and pymeshlab from PyPI, in target/blender-venv).
 # Needs the Rust toolchain, gcc/g++ and python3; installs numpy and pytest into the venv,
-# and valgrind with apt-get if it is missing.
+# bpy and pymeshlab into the venvs, and valgrind with apt-get if it is missing.
 # Tests that need the benchmark data (../shared/data or $SHAPECORR_DATA) skip cleanly
 # without it.
 set -euo pipefail
@@ -15,3 +16,4 @@ cargo test --release --locked --all-targets
 cargo test --release --locked --doc
 bash tests/c/run.sh
 bash tests/python/run.sh
+bash tests/blender/run.sh

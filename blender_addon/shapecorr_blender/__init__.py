@@ -1,0 +1,26 @@
+"""shapecorr for Blender: "Match Regions" colours the matching regions of two selected meshes
+in place, "Detect Symmetry" the symmetric regions of one (3D viewport sidebar, tab
+"shapecorr"). The work is done by the bundled libshapecorr through its Python binding."""
+
+import bpy
+
+from . import operators, panel, properties
+
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(
+    (
+        properties.ShapecorrSettings,
+        operators.SHAPECORR_OT_match_regions,
+        operators.SHAPECORR_OT_detect_symmetry,
+        panel.SHAPECORR_PT_panel,
+    )
+)
+
+
+def register():
+    _register_classes()
+    bpy.types.Scene.shapecorr = bpy.props.PointerProperty(type=properties.ShapecorrSettings)
+
+
+def unregister():
+    del bpy.types.Scene.shapecorr
+    _unregister_classes()

@@ -1,0 +1,292 @@
+"""The operators: read the evaluated meshes in world space, call libshapecorr, write the
+result in place as attributes.
+
+Run from the UI (invoke), the library works in a background thread while a modal handler
+shows progress and lets Esc cancel; run from a script (execute), it blocks. Either way the
+result is written by the main thread, in one undo step.
+"""
+
+import threading
+
+import bpy
+import numpy as np
+
+from . import shapecorr
+
+#: Colour attribute (point domain): matched regions share a colour, unmatched ones dark grey.
+COLOR_ATTRIBUTE = "shapecorr_regions"
+#: Integer attribute (point domain): the region id of every vertex.
+REGION_ATTRIBUTE = "shapecorr_region"
+
+#: Pipeline stages as reported by the library, in order (for one overall progress value).
+_STAGES = ["laplacian", "eigenbasis", "descriptors", "segmentation", "matching", "symmetry_breaking"]
+
+
+def selection_problem(context, wanted):
+    """Why the operator cannot run on the selection (None when it can)."""
+    selected = list(getattr(context, "selected_objects", []) or [])
+    meshes = [o for o in selected if o.type == "MESH"]
+    noun = "mesh object" if wanted == 1 else "mesh objects"
+    if len(meshes) != len(selected):
+        return f"Select only mesh objects ({len(selected) - len(meshes)} other selected)"
+    if len(meshes) != wanted:
+        return f"Select exactly {wanted} {noun} ({len(meshes)} selected)"
+    if getattr(context, "mode", "OBJECT") != "OBJECT":
+        return "Switch to Object Mode"
+    return None
+
+
+def ordered_selection(context):
+    """The selected meshes, the active one first (it is shape A)."""
+    selected = [o for o in context.selected_objects if o.type == "MESH"]
+    active = context.view_layer.objects.active
+    selected.sort(key=lambda o: (o != active, o.name))
+    return selected
+
+
+def read_shape(obj, depsgraph, as_point_cloud):
+    """The evaluated mesh of ``obj`` (modifiers applied) in world space, as a
+    shapecorr.Shape, in Blender's vertex order. Raises ValueError with a message for the
+    user when the evaluated mesh cannot be written back to the object's own vertices."""
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        n = len(mesh.vertices)
+        if n != len(obj.data.vertices):
+            raise ValueError(
+                f"'{obj.name}': its modifiers change the vertex count "
+                f"({len(obj.data.vertices)} -> {n}); apply them first"
+            )
+        coordinates = np.empty(3 * n, dtype=np.float32)
+        mesh.vertices.foreach_get("co", coordinates)
+        matrix = np.array(evaluated.matrix_world, dtype=np.float64)
+        world = coordinates.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+        mesh.calc_loop_triangles()
+        triangles = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
+        mesh.loop_triangles.foreach_get("vertices", triangles)
+    finally:
+        evaluated.to_mesh_clear()
+    if as_point_cloud or len(triangles) == 0:
+        return shapecorr.Shape.point_cloud(world)
+    return shapecorr.Shape.mesh(world, triangles.reshape(-1, 3))
+
+
+def write_regions(obj, regions, rgba):
+    """Writes the region ids and colours as point attributes of ``obj``'s mesh, makes the
+    colour attribute the active (and rendered) one."""
+    mesh = obj.data
+    for name in (COLOR_ATTRIBUTE, REGION_ATTRIBUTE):
+        existing = mesh.attributes.get(name)
+        if existing is not None:
+            mesh.attributes.remove(existing)
+    colors = mesh.color_attributes.new(COLOR_ATTRIBUTE, "BYTE_COLOR", "POINT")
+    # The library's colours are sRGB bytes; color_srgb takes them as 0..1 floats.
+    colors.data.foreach_set("color_srgb", (rgba.astype(np.float32) / 255.0).ravel())
+    region = mesh.attributes.new(REGION_ATTRIBUTE, "INT", "POINT")
+    region.data.foreach_set("value", regions.astype(np.int32))
+    mesh.color_attributes.active_color_name = COLOR_ATTRIBUTE
+    mesh.color_attributes.render_color_index = mesh.color_attributes.active_color_index
+    mesh.update()
+
+
+def show_attribute_colors(context):
+    """Switches solid-mode 3D views of the current screen to attribute colours."""
+    screen = getattr(context, "screen", None)
+    if screen is None:
+        return
+    for area in screen.areas:
+        if area.type != "VIEW_3D":
+            continue
+        for space in area.spaces:
+            if space.type == "VIEW_3D":
+                if space.shading.type == "WIREFRAME":
+                    space.shading.type = "SOLID"
+                space.shading.color_type = "VERTEX"
+        area.tag_redraw()
+
+
+class _Job:
+    """A library call run in a thread: progress in, cancel flag out."""
+
+    def __init__(self, work):
+        self.work = work
+        self.cancel = threading.Event()
+        self.fraction = 0.0
+        self.result = None
+        self.error = None
+        self.thread = None
+
+    def progress(self, stage, fraction):
+        index = _STAGES.index(stage) if stage in _STAGES else 0
+        self.fraction = max(self.fraction, (index + fraction) / len(_STAGES))
+        return not self.cancel.is_set()
+
+    def run(self):
+        try:
+            self.result = self.work(self.progress)
+        except Exception as error:  # noqa: BLE001 - reported by the operator, never lost
+            self.error = error
+
+    def start(self):
+        self.thread = threading.Thread(target=self.run, name="shapecorr", daemon=True)
+        self.thread.start()
+
+
+class _LibraryOperator:
+    """Shared invoke/modal/execute: subclasses give ``prepare`` (main thread: read the
+    scene, return the work function) and ``apply`` (main thread: write the result)."""
+
+    bl_options = {"REGISTER", "UNDO"}
+    _timer = None
+    _job = None
+
+    def execute(self, context):
+        try:
+            work = self.prepare(context)
+        except (ValueError, shapecorr.ShapecorrError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        wm = context.window_manager
+        wm.progress_begin(0, 1000)
+        job = _Job(work)
+
+        def progress(stage, fraction):
+            keep_going = job.progress(stage, fraction)
+            wm.progress_update(int(1000 * job.fraction))
+            return keep_going
+
+        try:
+            job.result = work(progress)
+        except shapecorr.ShapecorrError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        return self.finish(context, job.result)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        try:
+            work = self.prepare(context)
+        except (ValueError, shapecorr.ShapecorrError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self._job = _Job(work)
+        self._job.start()
+        wm = context.window_manager
+        wm.progress_begin(0, 1000)
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.modal_handler_add(self)
+        self.report({"INFO"}, "shapecorr: working (Esc cancels)")
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        job = self._job
+        if event.type == "ESC":
+            job.cancel.set()
+        if event.type != "TIMER":
+            return {"RUNNING_MODAL"}
+        context.window_manager.progress_update(int(1000 * job.fraction))
+        if job.thread.is_alive():
+            return {"RUNNING_MODAL"}
+        self._stop(context)
+        if job.error is not None:
+            cancelled = getattr(job.error, "status_name", "") == "CANCELLED"
+            self.report({"WARNING"} if cancelled else {"ERROR"}, str(job.error))
+            return {"CANCELLED"}
+        return self.finish(context, job.result)
+
+    def cancel(self, context):
+        if self._job is not None:
+            self._job.cancel.set()
+            self._job.thread.join()
+        self._stop(context)
+
+    def _stop(self, context):
+        wm = context.window_manager
+        if self._timer is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+
+    def finish(self, context, result):
+        try:
+            message = self.apply(context, result)
+        except (ValueError, ReferenceError) as error:
+            self.report({"ERROR"}, f"shapecorr: the result could not be written: {error}")
+            return {"CANCELLED"}
+        show_attribute_colors(context)
+        self.report({"INFO"}, message)
+        return {"FINISHED"}
+
+
+class SHAPECORR_OT_match_regions(_LibraryOperator, bpy.types.Operator):
+    """Colour the matching regions of the two selected meshes (the active one is A)"""
+
+    bl_idname = "shapecorr.match_regions"
+    bl_label = "Match Regions"
+
+    @classmethod
+    def poll(cls, context):
+        problem = selection_problem(context, 2)
+        if problem:
+            cls.poll_message_set(problem)
+        return problem is None
+
+    def prepare(self, context):
+        settings = context.scene.shapecorr
+        depsgraph = context.evaluated_depsgraph_get()
+        objects = ordered_selection(context)
+        shapes = [read_shape(o, depsgraph, settings.point_cloud) for o in objects]
+        self._names = [o.name for o in objects]
+        options = settings.library_options()
+
+        def work(progress):
+            return shapecorr.match(shapes[0], shapes[1], progress=progress, **options)
+
+        return work
+
+    def apply(self, context, result):
+        one_to_one = context.scene.shapecorr.one_to_one
+        objects = [bpy.data.objects[name] for name in self._names]
+        for obj, side in zip(objects, ("a", "b")):
+            write_regions(obj, result.regions(side), result.colors(side, one_to_one=one_to_one))
+        matches = result.matches_one_to_one if one_to_one else result.matches
+        return (
+            f"shapecorr: {len(matches)} region matches between '{objects[0].name}' "
+            f"({result.n_regions('a')} regions) and '{objects[1].name}' "
+            f"({result.n_regions('b')} regions)"
+        )
+
+
+class SHAPECORR_OT_detect_symmetry(_LibraryOperator, bpy.types.Operator):
+    """Colour the symmetric regions of the selected mesh (regions of one group share a colour)"""
+
+    bl_idname = "shapecorr.detect_symmetry"
+    bl_label = "Detect Symmetry"
+
+    @classmethod
+    def poll(cls, context):
+        problem = selection_problem(context, 1)
+        if problem:
+            cls.poll_message_set(problem)
+        return problem is None
+
+    def prepare(self, context):
+        settings = context.scene.shapecorr
+        obj = ordered_selection(context)[0]
+        shape = read_shape(obj, context.evaluated_depsgraph_get(), settings.point_cloud)
+        self._names = [obj.name]
+        options = settings.library_options(one_to_one=False)
+
+        def work(progress):
+            return shapecorr.detect_symmetry(shape, progress=progress, **options)
+
+        return work
+
+    def apply(self, context, result):
+        obj = bpy.data.objects[self._names[0]]
+        write_regions(obj, result.regions, result.colors())
+        groups = [g for g in result.groups if len(g) > 1]
+        return f"shapecorr: {len(groups)} groups of symmetric regions on '{obj.name}'"

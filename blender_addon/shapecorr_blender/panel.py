@@ -1,0 +1,28 @@
+"""The sidebar panel (View3D > Sidebar > shapecorr)."""
+
+import bpy
+
+from .operators import selection_problem
+
+
+class SHAPECORR_PT_panel(bpy.types.Panel):
+    bl_label = "shapecorr"
+    bl_idname = "SHAPECORR_PT_panel"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "shapecorr"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.shapecorr
+        column = layout.column(align=True)
+        column.prop(settings, "k_min")
+        column.prop(settings, "k_max")
+        layout.prop(settings, "one_to_one")
+        layout.prop(settings, "point_cloud")
+        layout.operator("shapecorr.match_regions", icon="MOD_DATA_TRANSFER")
+        problem = selection_problem(context, 2)
+        if problem:
+            layout.label(text=problem, icon="INFO")
+        layout.operator("shapecorr.detect_symmetry", icon="MOD_MIRROR")
+        layout.label(text="Esc cancels a running match", icon="CANCEL")

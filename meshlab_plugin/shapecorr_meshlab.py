@@ -1,0 +1,109 @@
+"""Colour the matching regions of two meshes for MeshLab, with pymeshlab and libshapecorr.
+
+    python meshlab_plugin/shapecorr_meshlab.py A.ply B.stl --out-a A_col.ply --out-b B_col.ply
+
+loads both files with pymeshlab's MeshSet (every format MeshLab reads), matches their
+regions, and saves each mesh with vertex colours (matched regions share a colour, unmatched
+ones are dark grey) and the region id of every vertex as its quality (a per-vertex scalar,
+shown by MeshLab's "Colorize by vertex quality") and as the custom attribute
+``shapecorr_region``. As a function::
+
+    import pymeshlab, shapecorr_meshlab
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh("A.ply")
+    ms.load_new_mesh("B.ply")
+    coloured = shapecorr_meshlab.match_regions(ms)     # a new MeshSet: mesh 0 is A, 1 is B
+"""
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+import pymeshlab
+
+try:
+    import shapecorr
+except ImportError:  # a source checkout: use the binding next to this script
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bindings" / "python"))
+    import shapecorr
+
+#: Name of the per-vertex custom scalar attribute holding the region id.
+REGION_ATTRIBUTE = "shapecorr_region"
+
+
+def shape_of(mesh, as_point_cloud=False):
+    """A shapecorr shape from a pymeshlab mesh (same vertex order)."""
+    vertices = mesh.vertex_matrix()
+    faces = mesh.face_matrix()
+    if as_point_cloud or len(faces) == 0:
+        return shapecorr.Shape.point_cloud(vertices)
+    return shapecorr.Shape.mesh(vertices, faces)
+
+
+def coloured(mesh, regions, rgba):
+    """A copy of ``mesh`` with vertex colours, the region id as vertex quality and as the
+    custom attribute ``shapecorr_region``."""
+    faces = mesh.face_matrix()
+    result = pymeshlab.Mesh(
+        vertex_matrix=mesh.vertex_matrix(),
+        face_matrix=faces if len(faces) else np.zeros((0, 3), dtype=np.int32),
+        v_color_matrix=rgba.astype(np.float64) / 255.0,
+        v_scalar_array=regions.astype(np.float64),
+    )
+    result.add_vertex_custom_scalar_attribute(regions.astype(np.float64), REGION_ATTRIBUTE)
+    return result
+
+
+def match_regions(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, progress=None, **options):
+    """Matches meshes ``id_a`` and ``id_b`` of the MeshSet ``ms`` and returns a new MeshSet
+    holding their coloured copies (A first, then B). ``options`` are shapecorr's named
+    options (``k_min``, ``k_max``, ...; ``shapecorr.options()`` lists them). Raises
+    shapecorr.ShapecorrError on bad input."""
+    mesh_a, mesh_b = ms.mesh(id_a), ms.mesh(id_b)
+    result = shapecorr.match(
+        shape_of(mesh_a, as_point_cloud),
+        shape_of(mesh_b, as_point_cloud),
+        progress=progress,
+        one_to_one=one_to_one,
+        **options,
+    )
+    out = pymeshlab.MeshSet()
+    for mesh, side in ((mesh_a, "a"), (mesh_b, "b")):
+        out.add_mesh(coloured(mesh, result.regions(side), result.colors(side, one_to_one=one_to_one)))
+    return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="Colour the matching regions of two meshes (shapecorr).")
+    parser.add_argument("a", help="first mesh (any format MeshLab reads)")
+    parser.add_argument("b", help="second mesh")
+    parser.add_argument("--out-a", required=True, help="coloured copy of A (e.g. A_col.ply)")
+    parser.add_argument("--out-b", required=True, help="coloured copy of B")
+    parser.add_argument("--k-min", type=int, help="smallest number of joint clusters")
+    parser.add_argument("--k-max", type=int, help="largest number of joint clusters")
+    parser.add_argument("--symmetric", action="store_true", help="colour by symmetric matches (no one-to-one)")
+    parser.add_argument("--points", action="store_true", help="treat both as point clouds")
+    args = parser.parse_args(argv)
+    options = {name: value for name, value in (("k_min", args.k_min), ("k_max", args.k_max)) if value is not None}
+    ms = pymeshlab.MeshSet()
+    try:
+        ms.load_new_mesh(str(args.a))
+        ms.load_new_mesh(str(args.b))
+    except pymeshlab.PyMeshLabException as error:
+        print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
+        return 1
+    try:
+        result = match_regions(ms, one_to_one=not args.symmetric, as_point_cloud=args.points, **options)
+    except shapecorr.ShapecorrError as error:
+        print(f"shapecorr_meshlab: {error}", file=sys.stderr)
+        return 1
+    for mesh_id, path in ((0, args.out_a), (1, args.out_b)):
+        result.set_current_mesh(mesh_id)
+        result.save_current_mesh(str(path), save_vertex_color=True, save_vertex_quality=True)
+    print(f"shapecorr_meshlab: wrote {args.out_a} and {args.out_b}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

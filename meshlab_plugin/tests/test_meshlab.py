@@ -1,0 +1,102 @@
+"""The MeshLab script with pymeshlab from PyPI, on generated figures: as a function on a
+MeshSet, as a command on PLY files, on an STL file (which pymeshlab reads and the library's
+own reader does not), and on bad input."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pymeshlab
+import pytest
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPOSITORY / "meshlab_plugin"))
+import shapecorr_meshlab  # noqa: E402
+from shapecorr_meshlab import shapecorr  # noqa: E402
+
+SCRIPT = REPOSITORY / "meshlab_plugin" / "shapecorr_meshlab.py"
+
+
+def figure_mesh(kind, pose, size=2500):
+    shape = shapecorr.Shape.figure(kind, pose, size)
+    return pymeshlab.Mesh(vertex_matrix=shape.vertices, face_matrix=shape.triangles.astype(np.int32))
+
+
+def save(mesh, path):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(mesh)
+    ms.save_current_mesh(str(path))
+
+
+def test_function_takes_and_returns_a_meshset():
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(figure_mesh("humanoid", 0))
+    ms.add_mesh(figure_mesh("humanoid", 3))
+    out = shapecorr_meshlab.match_regions(ms, k_max=8)
+    assert out.mesh_number() == 2
+    expected = shapecorr.match(
+        shapecorr_meshlab.shape_of(ms.mesh(0)), shapecorr_meshlab.shape_of(ms.mesh(1)), k_max=8
+    )
+    for mesh_id, side in ((0, "a"), (1, "b")):
+        mesh = out.mesh(mesh_id)
+        colours = np.round(mesh.vertex_color_matrix() * 255).astype(np.uint8)
+        assert np.array_equal(colours, expected.colors(side))
+        assert np.array_equal(mesh.vertex_scalar_array(), expected.regions(side))
+        custom = mesh.vertex_custom_scalar_attribute_array(shapecorr_meshlab.REGION_ATTRIBUTE)
+        assert np.array_equal(custom, expected.regions(side))
+        assert np.array_equal(mesh.vertex_matrix(), ms.mesh(mesh_id).vertex_matrix())
+
+
+def run_script(*args):
+    return subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def test_command_writes_coloured_files_with_region_ids(tmp_path):
+    save(figure_mesh("quadruped", 0), tmp_path / "a.ply")
+    save(figure_mesh("quadruped", 2), tmp_path / "b.ply")
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "a_col.ply", "--out-b", tmp_path / "b_col.ply")
+    assert done.returncode == 0, done.stderr
+    expected = shapecorr.match(shapecorr.Shape.read(tmp_path / "a.ply"), shapecorr.Shape.read(tmp_path / "b.ply"))
+    for name, side in (("a_col.ply", "a"), ("b_col.ply", "b")):
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(str(tmp_path / name))
+        mesh = ms.current_mesh()
+        colours = np.round(mesh.vertex_color_matrix() * 255).astype(np.uint8)
+        assert np.array_equal(colours, expected.colors(side))
+        assert np.array_equal(mesh.vertex_scalar_array(), expected.regions(side))
+    # Shared vertex order: matched regions mostly share colours across the two files.
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(tmp_path / "a_col.ply"))
+    ms.load_new_mesh(str(tmp_path / "b_col.ply"))
+    agree = np.mean(np.all(ms.mesh(0).vertex_color_matrix() == ms.mesh(1).vertex_color_matrix(), axis=1))
+    assert agree > 0.5, agree
+
+
+def test_a_format_only_meshlab_reads(tmp_path):
+    save(figure_mesh("star5", 0), tmp_path / "a.stl")
+    save(figure_mesh("star5", 2), tmp_path / "b.ply")
+    with pytest.raises(shapecorr.ShapecorrError):
+        shapecorr.Shape.read(tmp_path / "a.stl")  # the library has no STL reader
+    done = run_script(tmp_path / "a.stl", tmp_path / "b.ply", "--out-a", tmp_path / "a_col.ply", "--out-b", tmp_path / "b_col.ply", "--symmetric")
+    assert done.returncode == 0, done.stderr
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(tmp_path / "a_col.ply"))
+    mesh = ms.current_mesh()
+    regions = mesh.vertex_scalar_array()
+    assert mesh.vertex_number() > 1000 and regions.max() >= 4
+    assert len({tuple(c) for c in np.round(mesh.vertex_color_matrix() * 255).astype(int)}) >= 3
+
+
+def test_bad_input_exits_with_a_reason(tmp_path):
+    tetrahedron = pymeshlab.Mesh(
+        vertex_matrix=np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float),
+        face_matrix=np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.int32),
+    )
+    save(tetrahedron, tmp_path / "tiny.ply")
+    save(figure_mesh("star4", 0, 1000), tmp_path / "b.ply")
+    done = run_script(tmp_path / "tiny.ply", tmp_path / "b.ply", "--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply")
+    assert done.returncode == 1 and "TOO_FEW_VERTICES" in done.stderr
+    missing = run_script(tmp_path / "nothing.ply", tmp_path / "b.ply", "--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply")
+    assert missing.returncode == 1 and "cannot load" in missing.stderr
+    assert not (tmp_path / "x.ply").exists()
