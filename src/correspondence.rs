@@ -77,7 +77,25 @@ impl Params {
         self.eigen.validate()?;
         self.hks.validate()?;
         self.segmentation.validate()?;
-        self.matching.validate()
+        self.matching.validate()?;
+        if let Some(fallback) = &self.fallback {
+            if !(fallback.hks_t_min > 0.0 && fallback.hks_t_min <= self.hks.t_max) {
+                return Err(crate::Error::InvalidParameter {
+                    name: "fallback.hks_t_min",
+                    reason: format!(
+                        "need 0 < t_min <= hks.t_max = {}, got {}",
+                        self.hks.t_max, fallback.hks_t_min
+                    ),
+                });
+            }
+            if !(0.0..=1.0).contains(&fallback.max_unmatched) {
+                return Err(crate::Error::InvalidParameter {
+                    name: "fallback.max_unmatched",
+                    reason: format!("must lie in [0, 1], got {}", fallback.max_unmatched),
+                });
+            }
+        }
+        Ok(())
     }
 }
 

@@ -229,6 +229,9 @@ impl Params {
             OptionValue::Bool(v) => match info.name {
                 "hks_log" => self.hks.log = v,
                 "one_to_one" => self.skip_one_to_one = !v,
+                "hks_fallback" => {
+                    self.fallback = v.then(|| self.fallback.clone().unwrap_or_default())
+                }
                 other => unreachable!("bool option {other} has no field"),
             },
         }
@@ -259,6 +262,7 @@ impl Params {
             "one_to_one" => OptionValue::Bool(!self.skip_one_to_one),
             "exhaustive_limit" => int(self.symmetry.exhaustive_limit),
             "symmetry_restarts" => int(self.symmetry.restarts),
+            "hks_fallback" => OptionValue::Bool(self.fallback.is_some()),
             other => unreachable!("option {other} has no field"),
         })
     }

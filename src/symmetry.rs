@@ -9,8 +9,9 @@
 //!
 //! - [`OneToOneMethod::WholeAssignment`] (default; DESIGN section 4, the measured best):
 //!   choose all groups' options together to minimise the unweighted distortion of the
-//!   region distances, [`distortion_energy`]:
-//!   `E(P) = (1/|P|^2) * sum_{(i,j),(k,l) in P} |D1[i,k] - D2[j,l]|`.
+//!   region distances, `E(P) = (1/|P|^2) * sum_{(i,j),(k,l) in P} c(D1[i,k] - D2[j,l])`
+//!   with the cost `c` of [`DistortionCost`]: squared by default (measured better than
+//!   DESIGN's absolute value, see there); [`distortion_energy`] is the absolute form.
 //!   Exhaustively when the product of the option counts is at most
 //!   [`SymmetryParams::exhaustive_limit`]; otherwise by group-wise sweeps from a greedy
 //!   start and seeded random starts.
