@@ -213,7 +213,7 @@ class _LibraryOperator:
     def finish(self, context, result):
         try:
             message = self.apply(context, result)
-        except (ValueError, ReferenceError) as error:
+        except (ValueError, ReferenceError, KeyError) as error:
             self.report({"ERROR"}, f"shapecorr: the result could not be written: {error}")
             return {"CANCELLED"}
         show_attribute_colors(context)
