@@ -11,22 +11,17 @@
 //! start block comes from a fixed seed, so results are deterministic.
 //! Small shapes use a dense eigensolver instead.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::dyn_stack::MemBuffer;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::ReborrowMut;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
-};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::laplacian::Laplacian;
 use crate::progress::{check, NoProgress, Progress, Stage};
 use crate::shape::Shape;
+use crate::sparse::SparseCholesky;
 use crate::{Error, Result};
 
 /// Parameters of the eigensolver. The defaults are the documented ones.
@@ -226,62 +221,23 @@ fn dense_eigenpairs(laplacian: &Laplacian, k: usize) -> Result<(Vec<f64>, Mat<f6
 /// errors at vertices with tiny mass (measured: residuals 4e-10 instead of 1e-11 on a
 /// 52K-vertex TOSCA shape).
 struct ShiftInvert {
-    symbolic: SymbolicCholesky<usize>,
-    factor_values: Vec<f64>,
+    factor: SparseCholesky,
     mass: Vec<f64>,
-    par: Par,
 }
 
 impl ShiftInvert {
     fn new(laplacian: &Laplacian, shift: f64, par: Par) -> Result<ShiftInvert> {
-        let n = laplacian.len();
-        let numerical = |reason: String| Error::Numerical {
-            stage: "sparse Cholesky of L + sigma M",
-            reason,
-        };
-        // Upper triangle of A = L + sigma M.
-        let mut triplets = Vec::with_capacity(laplacian.stiffness.nnz() / 2 + n);
-        for (col, column) in laplacian.stiffness.outer_iterator().enumerate() {
-            for (row, &value) in column.iter() {
-                if row < col {
-                    triplets.push(Triplet::new(row, col, value));
-                }
-            }
-        }
-        for (i, &m) in laplacian.mass.iter().enumerate() {
-            let diagonal = laplacian.stiffness.get(i, i).copied().unwrap_or(0.0);
-            triplets.push(Triplet::new(i, i, diagonal + shift * m));
-        }
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
-            .map_err(|e| numerical(format!("{e:?}")))?;
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Upper,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| numerical(format!("{e:?}")))?;
-        let mut factor_values = vec![0.0; symbolic.len_val()];
-        let mut buffer = MemBuffer::try_new(
-            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
-        )
-        .map_err(|_| numerical("out of memory".into()))?;
-        symbolic
-            .factorize_numeric_llt(
-                &mut factor_values,
-                a.as_ref(),
-                Side::Upper,
-                LltRegularization::default(),
-                par,
-                MemStack::new(&mut buffer),
-                Default::default(),
-            )
-            .map_err(|e| numerical(format!("not positive definite ({e:?})")))?;
-        Ok(ShiftInvert {
-            symbolic,
-            factor_values,
-            mass: laplacian.mass.clone(),
+        let diagonal: Vec<f64> = laplacian.mass.iter().map(|m| shift * m).collect();
+        let factor = SparseCholesky::new(
+            &laplacian.stiffness,
+            1.0,
+            &diagonal,
             par,
+            "sparse Cholesky of L + sigma M",
+        )?;
+        Ok(ShiftInvert {
+            factor,
+            mass: laplacian.mass.clone(),
         })
     }
 
@@ -296,17 +252,11 @@ impl ShiftInvert {
                 out[(i, j)] = x[(i, j)] * self.mass[i];
             }
         }
-        let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &self.factor_values);
-        llt.solve_in_place_with_conj(Conj::No, out.rb_mut(), self.par, MemStack::new(buffer));
+        self.factor.solve_in_place(out.rb_mut(), buffer);
     }
 
     fn scratch(&self, ncols: usize) -> Result<MemBuffer> {
-        MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par)).map_err(
-            |_| Error::Numerical {
-                stage: "eigensolver",
-                reason: "out of memory".into(),
-            },
-        )
+        self.factor.scratch(ncols)
     }
 
     /// `M x` for a block of columns.

@@ -4,8 +4,8 @@
 //! These are **edge-graph** distances: Dijkstra over the mesh edges (or a point cloud's
 //! 6-NN graph) with Euclidean edge lengths. They overestimate the true geodesic distance by
 //! a few percent (paths are confined to edges), which is harmless at the region level,
-//! where only differences between region pairs of two shapes are compared. Accurate
-//! geodesics (the heat method) for the pointwise evaluation come later.
+//! where only differences between region pairs of two shapes are compared. [`HeatGeodesics`]
+//! gives accurate geodesic distances (the heat method) for evaluating pointwise maps.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -13,7 +13,10 @@ use std::collections::BinaryHeap;
 use faer::Mat;
 use rayon::prelude::*;
 
-use crate::Shape;
+use crate::laplacian::{heron_area, mollified_edge_lengths, triangulation, Laplacian};
+use crate::shape::DisjointSets;
+use crate::sparse::SparseCholesky;
+use crate::{Error, Result, Shape};
 
 /// Stands in for the distance between two regions that cannot reach each other (different
 /// connected pieces) in [`region_distance_matrix`]: this factor times the largest finite
@@ -271,6 +274,203 @@ pub fn region_distance_matrix(
             0.5 * (mean(r, q) + mean(q, r))
         }
     })
+}
+
+/// Geodesic distances by the **heat method** (Crane, Weischedel and Wardetzky 2013), accurate
+/// enough for evaluating pointwise maps (edge-graph distances are not): heat flows from the
+/// sources for a short time `t = h^2` (`(M + t L) u = delta`), its normalised gradient
+/// `X = -grad u / |grad u|` points along the geodesics, and the distance solves
+/// `L phi = -div X`. Both matrices are factored once in [`HeatGeodesics::new`]; each call
+/// of [`HeatGeodesics::distances`] is two sparse solves. Gradients and divergences use the
+/// same intrinsically mollified edge lengths as the Laplacian, so degenerate triangles are
+/// handled the same way. Point clouds use the Laplacian's local triangulations.
+pub struct HeatGeodesics {
+    heat: SparseCholesky,
+    poisson: SparseCholesky,
+    triangles: Vec<[u32; 3]>,
+    /// Per triangle: the cotangent of each corner and the 2D layout of its corners.
+    corners: Vec<TriangleFrame>,
+    /// Weight of each triangle (1 for a mesh, 1/3 for a point cloud's local triangles).
+    weight: f64,
+    /// Connected piece of each active vertex.
+    piece: Vec<usize>,
+    /// Active index of every input vertex (through its representative).
+    active_of_input: Vec<u32>,
+}
+
+struct TriangleFrame {
+    points: [[f64; 2]; 3],
+    cot: [f64; 3],
+    area: f64,
+}
+
+/// Regularisation of `L` in the distance solve (on the unit-area shape, whose first
+/// non-zero eigenvalue is O(10)): it only fixes the free constant.
+const POISSON_SHIFT: f64 = 1e-6;
+
+impl HeatGeodesics {
+    /// Prepares the solver for a shape (factors `M + t L` and `L + eps M`).
+    pub fn new(shape: &Shape) -> Result<HeatGeodesics> {
+        let laplacian = Laplacian::new(shape)?;
+        let (positions, triangles, weight) = triangulation(shape);
+        let lengths = mollified_edge_lengths(&positions, &triangles);
+        let scale = laplacian.input_area.sqrt();
+        let corners: Vec<TriangleFrame> = lengths.iter().map(|l| TriangleFrame::new(*l)).collect();
+        let mean_edge = lengths.iter().flatten().sum::<f64>() / (3 * lengths.len()) as f64 / scale;
+        let t = mean_edge * mean_edge;
+        let par = faer::Par::Seq;
+        let heat = SparseCholesky::new(
+            &laplacian.stiffness,
+            t,
+            &laplacian.mass,
+            par,
+            "heat method: M + t L",
+        )?;
+        let shift: Vec<f64> = laplacian.mass.iter().map(|m| POISSON_SHIFT * m).collect();
+        let poisson = SparseCholesky::new(
+            &laplacian.stiffness,
+            1.0,
+            &shift,
+            par,
+            "heat method: L + eps M",
+        )?;
+        let mut sets = DisjointSets::new(positions.len());
+        for t in &triangles {
+            sets.union(t[0] as usize, t[1] as usize);
+            sets.union(t[0] as usize, t[2] as usize);
+        }
+        let piece = (0..positions.len()).map(|v| sets.find(v)).collect();
+        let mut active_index = vec![u32::MAX; shape.n_vertices()];
+        for (i, &v) in shape.active_vertices().iter().enumerate() {
+            active_index[v as usize] = i as u32;
+        }
+        let active_of_input = shape
+            .representative()
+            .iter()
+            .map(|&r| active_index[r as usize])
+            .collect();
+        Ok(HeatGeodesics {
+            heat,
+            poisson,
+            triangles,
+            corners,
+            weight,
+            piece,
+            active_of_input,
+        })
+    }
+
+    /// For every input vertex, the geodesic distance (in the input's units) to the nearest
+    /// of `sources` (input vertex indices); `f64::INFINITY` on pieces without a source.
+    pub fn distances(&self, sources: &[u32]) -> Result<Vec<f64>> {
+        let n_input = self.active_of_input.len();
+        if sources.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "sources",
+                reason: "give at least one source vertex".into(),
+            });
+        }
+        if let Some(&bad) = sources.iter().find(|&&s| s as usize >= n_input) {
+            return Err(Error::InvalidParameter {
+                name: "sources",
+                reason: format!("vertex {bad} is out of range: the shape has {n_input} vertices"),
+            });
+        }
+        let n = self.heat.len();
+        let active_sources: Vec<usize> = sources
+            .iter()
+            .map(|&s| self.active_of_input[s as usize] as usize)
+            .collect();
+        // 1. Heat flow from the sources.
+        let mut u = Mat::<f64>::zeros(n, 1);
+        for &s in &active_sources {
+            u[(s, 0)] = 1.0;
+        }
+        let mut buffer = self.heat.scratch(1)?;
+        self.heat.solve_in_place(u.as_mut(), &mut buffer);
+        // 2-3. Normalised gradient per triangle, integrated divergence per vertex.
+        let mut divergence = Mat::<f64>::zeros(n, 1);
+        for (t, frame) in self.triangles.iter().zip(&self.corners) {
+            let values = t.map(|v| u[(v as usize, 0)]);
+            let Some(x) = frame.unit_descent(values) else {
+                continue;
+            };
+            for k in 0..3 {
+                let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
+                let p = frame.points;
+                let e1 = [p[k1][0] - p[k][0], p[k1][1] - p[k][1]];
+                let e2 = [p[k2][0] - p[k][0], p[k2][1] - p[k][1]];
+                let dot = |e: [f64; 2]| e[0] * x[0] + e[1] * x[1];
+                divergence[(t[k] as usize, 0)] +=
+                    0.5 * self.weight * (frame.cot[k2] * dot(e1) + frame.cot[k1] * dot(e2));
+            }
+        }
+        // 4. L phi = -div X, then the smallest value at the sources is 0.
+        for i in 0..n {
+            divergence[(i, 0)] = -divergence[(i, 0)];
+        }
+        let mut buffer = self.poisson.scratch(1)?;
+        self.poisson
+            .solve_in_place(divergence.as_mut(), &mut buffer);
+        let phi = divergence;
+        let mut offset: std::collections::BTreeMap<usize, f64> = Default::default();
+        for &s in &active_sources {
+            let entry = offset.entry(self.piece[s]).or_insert(f64::INFINITY);
+            *entry = entry.min(phi[(s, 0)]);
+        }
+        Ok(self
+            .active_of_input
+            .iter()
+            .map(|&a| {
+                let a = a as usize;
+                match offset.get(&self.piece[a]) {
+                    // The divergence is built from input-unit lengths, so phi is in input units.
+                    Some(&o) => (phi[(a, 0)] - o).max(0.0),
+                    None => f64::INFINITY,
+                }
+            })
+            .collect())
+    }
+}
+
+impl TriangleFrame {
+    /// Lays out a triangle from its edge lengths (`l[k]` opposite corner `k`):
+    /// corner 0 at the origin, corner 1 on the x axis, corner 2 above it.
+    fn new(l: [f64; 3]) -> TriangleFrame {
+        let area = heron_area(l[0], l[1], l[2]);
+        let x = (l[1] * l[1] + l[2] * l[2] - l[0] * l[0]) / (2.0 * l[2]);
+        let y = (l[1] * l[1] - x * x).max(0.0).sqrt();
+        let cot = [0, 1, 2].map(|k| {
+            let (a, b, c) = (l[k], l[(k + 1) % 3], l[(k + 2) % 3]);
+            (b * b + c * c - a * a) / (4.0 * area)
+        });
+        TriangleFrame {
+            points: [[0.0, 0.0], [l[2], 0.0], [x, y]],
+            cot,
+            area,
+        }
+    }
+
+    /// `-grad u / |grad u|` for the linear function with corner values `u`, or `None` where
+    /// the gradient vanishes or the triangle has no area.
+    fn unit_descent(&self, u: [f64; 3]) -> Option<[f64; 2]> {
+        if !(self.area > 0.0) {
+            return None;
+        }
+        let p = self.points;
+        let mut g = [0.0; 2];
+        for k in 0..3 {
+            // grad phi_k = rot90(p[k+2] - p[k+1]) / (2 area)
+            let e = [
+                p[(k + 2) % 3][0] - p[(k + 1) % 3][0],
+                p[(k + 2) % 3][1] - p[(k + 1) % 3][1],
+            ];
+            g[0] += u[k] * -e[1];
+            g[1] += u[k] * e[0];
+        }
+        let norm = (g[0] * g[0] + g[1] * g[1]).sqrt();
+        (norm > 0.0 && norm.is_finite()).then(|| [-g[0] / norm, -g[1] / norm])
+    }
 }
 
 #[cfg(test)]

@@ -52,29 +52,7 @@ pub struct Laplacian {
 impl Laplacian {
     /// Builds the Laplacian of a mesh or point cloud.
     pub fn new(shape: &Shape) -> Result<Laplacian> {
-        let positions: Vec<[f64; 3]> = shape
-            .active_vertices()
-            .iter()
-            .map(|&v| shape.vertices()[v as usize])
-            .collect();
-        let (triangles, weight) = match shape.kind() {
-            ShapeKind::Mesh => {
-                let mut compact = vec![u32::MAX; shape.n_vertices()];
-                for (i, &v) in shape.active_vertices().iter().enumerate() {
-                    compact[v as usize] = i as u32;
-                }
-                let triangles: Vec<[u32; 3]> = shape
-                    .triangles()
-                    .iter()
-                    .map(|t| t.map(|v| compact[v as usize]))
-                    .collect();
-                (triangles, 1.0)
-            }
-            ShapeKind::PointCloud => (
-                local_delaunay_soup(&positions, POINT_CLOUD_NEIGHBORS),
-                1.0 / 3.0,
-            ),
-        };
+        let (positions, triangles, weight) = triangulation(shape);
         let (stiffness, mut mass) = cotan_laplacian(&positions, &triangles, weight);
         let input_area: f64 = mass.iter().sum();
         if !(input_area > 0.0 && input_area.is_finite()) {
@@ -101,6 +79,36 @@ impl Laplacian {
     /// True when the operator has no rows (never for a validated shape).
     pub fn is_empty(&self) -> bool {
         self.mass.is_empty()
+    }
+}
+
+/// The triangles the Laplacian is built on, over the active vertices (`positions[i]` is
+/// active vertex `i`), and the weight each counts with: a mesh's own triangles (weight 1),
+/// or a point cloud's local Delaunay triangles (each point's neighbourhood triangulated
+/// once, so every area is counted about three times: weight 1/3).
+pub(crate) fn triangulation(shape: &Shape) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, f64) {
+    let positions: Vec<[f64; 3]> = shape
+        .active_vertices()
+        .iter()
+        .map(|&v| shape.vertices()[v as usize])
+        .collect();
+    match shape.kind() {
+        ShapeKind::Mesh => {
+            let mut compact = vec![u32::MAX; shape.n_vertices()];
+            for (i, &v) in shape.active_vertices().iter().enumerate() {
+                compact[v as usize] = i as u32;
+            }
+            let triangles: Vec<[u32; 3]> = shape
+                .triangles()
+                .iter()
+                .map(|t| t.map(|v| compact[v as usize]))
+                .collect();
+            (positions, triangles, 1.0)
+        }
+        ShapeKind::PointCloud => {
+            let triangles = local_delaunay_soup(&positions, POINT_CLOUD_NEIGHBORS);
+            (positions, triangles, 1.0 / 3.0)
+        }
     }
 }
 
@@ -144,7 +152,10 @@ pub fn cotan_laplacian(
 /// Edge lengths per triangle (entry k opposite corner k), all grown by the smallest epsilon
 /// that gives every triangle a margin of `MOLLIFY_FACTOR * mean edge length` in its triangle
 /// inequalities.
-fn mollified_edge_lengths(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
+pub(crate) fn mollified_edge_lengths(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+) -> Vec<[f64; 3]> {
     let mut lengths: Vec<[f64; 3]> = triangles
         .iter()
         .map(|t| {
@@ -179,7 +190,7 @@ fn mollified_edge_lengths(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec
 }
 
 /// Triangle area from its edge lengths, by Kahan's numerically stable form of Heron's formula.
-fn heron_area(a: f64, b: f64, c: f64) -> f64 {
+pub(crate) fn heron_area(a: f64, b: f64, c: f64) -> f64 {
     let mut s = [a, b, c];
     s.sort_by(|x, y| y.total_cmp(x));
     let [a, b, c] = s;

@@ -52,6 +52,7 @@ pub mod options;
 pub mod progress;
 pub mod segmentation;
 pub mod shape;
+mod sparse;
 pub mod symmetry;
 pub mod synth;
 
