@@ -10,7 +10,7 @@ use std::time::Instant;
 use crate::correspondence::{Correspondence, Params};
 use crate::datasets::{read_pairs, Layout, Pair};
 use crate::eigen::Eigenbasis;
-use crate::evaluation::{score, RegionScores};
+use crate::evaluation::{score_correspondence, RegionScores};
 use crate::progress::NoProgress;
 use crate::shape::Shape;
 use crate::Result;
@@ -63,13 +63,10 @@ pub fn bench_regions(
             a.n_vertices(),
             b.n_vertices(),
         )?;
-        let scores = score(
-            result.regions_a(),
-            result.regions_b(),
+        let scores = score_correspondence(
+            &result,
             &basis_a.mass,
             &basis_b.mass,
-            &result.matches,
-            &result.matches_one_to_one,
             &truth,
             flipped.as_deref(),
         );

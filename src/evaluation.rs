@@ -60,6 +60,27 @@ pub fn region_accuracy(
     }
 }
 
+/// [`score`] of a computed correspondence (its regions and both kinds of matches), with the
+/// vertex masses of A and B.
+pub fn score_correspondence(
+    result: &crate::correspondence::Correspondence,
+    mass_a: &[f64],
+    mass_b: &[f64],
+    ground_truth: &[(u32, u32)],
+    ground_truth_flipped: Option<&[(u32, u32)]>,
+) -> RegionScores {
+    score(
+        result.regions_a(),
+        result.regions_b(),
+        mass_a,
+        mass_b,
+        &result.matches,
+        &result.matches_one_to_one,
+        ground_truth,
+        ground_truth_flipped,
+    )
+}
+
 /// All scores of a correspondence. `mirror_b[v]` is the mirror image of B's vertex v.
 #[allow(clippy::too_many_arguments)]
 pub fn score(

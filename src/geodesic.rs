@@ -13,7 +13,7 @@ use std::collections::BinaryHeap;
 use faer::Mat;
 use rayon::prelude::*;
 
-use crate::laplacian::{heron_area, mollified_edge_lengths, triangulation, Laplacian};
+use crate::laplacian::{heron_area, triangulation, Laplacian};
 use crate::shape::DisjointSets;
 use crate::sparse::SparseCholesky;
 use crate::{Error, Result, Shape};
@@ -311,9 +311,14 @@ const POISSON_SHIFT: f64 = 1e-6;
 impl HeatGeodesics {
     /// Prepares the solver for a shape (factors `M + t L` and `L + eps M`).
     pub fn new(shape: &Shape) -> Result<HeatGeodesics> {
-        let laplacian = Laplacian::new(shape)?;
-        let (positions, triangles, weight) = triangulation(shape);
-        let lengths = mollified_edge_lengths(&positions, &triangles);
+        let triangulation = triangulation(shape);
+        let laplacian = Laplacian::from_triangulation(&triangulation)?;
+        let (n, triangles, lengths, weight) = (
+            triangulation.positions.len(),
+            triangulation.triangles,
+            triangulation.lengths,
+            triangulation.weight,
+        );
         let scale = laplacian.input_area.sqrt();
         let corners: Vec<TriangleFrame> = lengths.iter().map(|l| TriangleFrame::new(*l)).collect();
         let mean_edge = lengths.iter().flatten().sum::<f64>() / (3 * lengths.len()) as f64 / scale;
@@ -334,12 +339,12 @@ impl HeatGeodesics {
             par,
             "heat method: L + eps M",
         )?;
-        let mut sets = DisjointSets::new(positions.len());
+        let mut sets = DisjointSets::new(n);
         for t in &triangles {
             sets.union(t[0] as usize, t[1] as usize);
             sets.union(t[0] as usize, t[2] as usize);
         }
-        let piece = (0..positions.len()).map(|v| sets.find(v)).collect();
+        let piece = (0..n).map(|v| sets.find(v)).collect();
         let mut active_index = vec![u32::MAX; shape.n_vertices()];
         for (i, &v) in shape.active_vertices().iter().enumerate() {
             active_index[v as usize] = i as u32;

@@ -52,8 +52,14 @@ pub struct Laplacian {
 impl Laplacian {
     /// Builds the Laplacian of a mesh or point cloud.
     pub fn new(shape: &Shape) -> Result<Laplacian> {
-        let (positions, triangles, weight) = triangulation(shape);
-        let (stiffness, mut mass) = cotan_laplacian(&positions, &triangles, weight);
+        Laplacian::from_triangulation(&triangulation(shape))
+    }
+
+    /// The Laplacian of a triangulation made by [`triangulation`] (so that callers that
+    /// also need the triangles and their lengths build them once).
+    pub(crate) fn from_triangulation(t: &Triangulation) -> Result<Laplacian> {
+        let (stiffness, mut mass) =
+            cotan_from_lengths(t.positions.len(), &t.triangles, &t.lengths, t.weight);
         let input_area: f64 = mass.iter().sum();
         if !(input_area > 0.0 && input_area.is_finite()) {
             return Err(Error::ZeroArea {
@@ -82,17 +88,28 @@ impl Laplacian {
     }
 }
 
-/// The triangles the Laplacian is built on, over the active vertices (`positions[i]` is
-/// active vertex `i`), and the weight each counts with: a mesh's own triangles (weight 1),
-/// or a point cloud's local Delaunay triangles (each point's neighbourhood triangulated
-/// once, so every area is counted about three times: weight 1/3).
-pub(crate) fn triangulation(shape: &Shape) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, f64) {
+/// The triangles a Laplacian is built on, over the active vertices.
+pub(crate) struct Triangulation {
+    /// `positions[i]` is active vertex `i`.
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Mollified edge lengths per triangle, `lengths[t][k]` opposite corner `k`.
+    pub lengths: Vec<[f64; 3]>,
+    /// The weight each triangle counts with: 1 for a mesh's own triangles, 1/3 for a point
+    /// cloud's local Delaunay triangles (each point's neighbourhood is triangulated once,
+    /// so every area is counted about three times).
+    pub weight: f64,
+}
+
+/// The triangulation of a shape's active vertices: a mesh's own triangles, or a point
+/// cloud's local Delaunay triangles, with mollified edge lengths.
+pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
     let positions: Vec<[f64; 3]> = shape
         .active_vertices()
         .iter()
         .map(|&v| shape.vertices()[v as usize])
         .collect();
-    match shape.kind() {
+    let (triangles, weight) = match shape.kind() {
         ShapeKind::Mesh => {
             let mut compact = vec![u32::MAX; shape.n_vertices()];
             for (i, &v) in shape.active_vertices().iter().enumerate() {
@@ -103,12 +120,19 @@ pub(crate) fn triangulation(shape: &Shape) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, f64
                 .iter()
                 .map(|t| t.map(|v| compact[v as usize]))
                 .collect();
-            (positions, triangles, 1.0)
+            (triangles, 1.0)
         }
-        ShapeKind::PointCloud => {
-            let triangles = local_delaunay_soup(&positions, POINT_CLOUD_NEIGHBORS);
-            (positions, triangles, 1.0 / 3.0)
-        }
+        ShapeKind::PointCloud => (
+            local_delaunay_soup(&positions, POINT_CLOUD_NEIGHBORS),
+            1.0 / 3.0,
+        ),
+    };
+    let lengths = mollified_edge_lengths(&positions, &triangles);
+    Triangulation {
+        positions,
+        triangles,
+        lengths,
+        weight,
     }
 }
 
@@ -120,12 +144,21 @@ pub fn cotan_laplacian(
     triangles: &[[u32; 3]],
     weight: f64,
 ) -> (CsMat<f64>, Vec<f64>) {
-    let n = positions.len();
     let lengths = mollified_edge_lengths(positions, triangles);
+    cotan_from_lengths(positions.len(), triangles, &lengths, weight)
+}
+
+/// [`cotan_laplacian`] from (mollified) edge lengths, `lengths[t][k]` opposite corner `k`.
+fn cotan_from_lengths(
+    n: usize,
+    triangles: &[[u32; 3]],
+    lengths: &[[f64; 3]],
+    weight: f64,
+) -> (CsMat<f64>, Vec<f64>) {
     let mut mass = vec![0.0; n];
     let mut entries = TriMat::with_capacity((n, n), 12 * triangles.len() + n);
     let mut diagonal = vec![0.0; n];
-    for (t, l) in triangles.iter().zip(&lengths) {
+    for (t, l) in triangles.iter().zip(lengths) {
         // l[k] is the length of the edge opposite corner k.
         let area = heron_area(l[0], l[1], l[2]);
         if area <= 0.0 {
@@ -152,10 +185,7 @@ pub fn cotan_laplacian(
 /// Edge lengths per triangle (entry k opposite corner k), all grown by the smallest epsilon
 /// that gives every triangle a margin of `MOLLIFY_FACTOR * mean edge length` in its triangle
 /// inequalities.
-pub(crate) fn mollified_edge_lengths(
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-) -> Vec<[f64; 3]> {
+fn mollified_edge_lengths(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
     let mut lengths: Vec<[f64; 3]> = triangles
         .iter()
         .map(|t| {

@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::{Parser, Subcommand};
 use serde_json::json;
 use shapecorr::correspondence::{region_colors, Correspondence, Params, Symmetry};
-use shapecorr::evaluation::score;
+use shapecorr::evaluation::score_correspondence;
 use shapecorr::graph::ShapeGraph;
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
@@ -714,13 +714,10 @@ fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
         .iter()
         .map(|&(v, p)| (mirror[v as usize], p))
         .collect();
-    let scores = score(
-        result.regions_a(),
-        result.regions_b(),
+    let scores = score_correspondence(
+        &result,
         &basis_a.mass,
         &basis_b.mass,
-        &result.matches,
-        &result.matches_one_to_one,
         &truth,
         Some(&flipped),
     );

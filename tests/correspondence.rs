@@ -1,7 +1,7 @@
 //! The whole region-correspondence pipeline on generated figures with known ground truth.
 
 use shapecorr::correspondence::{Correspondence, Params, Symmetry};
-use shapecorr::evaluation::{score, RegionScores};
+use shapecorr::evaluation::{score_correspondence, RegionScores};
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
 use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, Stage};
 
@@ -32,16 +32,7 @@ fn run(
         .iter()
         .map(|&(x, y)| (mirror_a[x as usize], y))
         .collect();
-    let scores = score(
-        result.regions_a(),
-        result.regions_b(),
-        &basis_a.mass,
-        &basis_b.mass,
-        &result.matches,
-        &result.matches_one_to_one,
-        truth,
-        Some(&flipped),
-    );
+    let scores = score_correspondence(&result, &basis_a.mass, &basis_b.mass, truth, Some(&flipped));
     println!("{scores:?}, k = {}", result.k);
     (result, scores)
 }

@@ -137,8 +137,17 @@ class _LibraryOperator:
     scene, return the work function) and ``apply`` (main thread: write the result)."""
 
     bl_options = {"REGISTER", "UNDO"}
+    #: How many selected meshes the operator works on.
+    selection_size = 0
     _timer = None
     _job = None
+
+    @classmethod
+    def poll(cls, context):
+        problem = selection_problem(context, cls.selection_size)
+        if problem:
+            cls.poll_message_set(problem)
+        return problem is None
 
     def execute(self, context):
         try:
@@ -226,13 +235,7 @@ class SHAPECORR_OT_match_regions(_LibraryOperator, bpy.types.Operator):
 
     bl_idname = "shapecorr.match_regions"
     bl_label = "Match Regions"
-
-    @classmethod
-    def poll(cls, context):
-        problem = selection_problem(context, 2)
-        if problem:
-            cls.poll_message_set(problem)
-        return problem is None
+    selection_size = 2
 
     def prepare(self, context):
         settings = context.scene.shapecorr
@@ -265,13 +268,7 @@ class SHAPECORR_OT_detect_symmetry(_LibraryOperator, bpy.types.Operator):
 
     bl_idname = "shapecorr.detect_symmetry"
     bl_label = "Detect Symmetry"
-
-    @classmethod
-    def poll(cls, context):
-        problem = selection_problem(context, 1)
-        if problem:
-            cls.poll_message_set(problem)
-        return problem is None
+    selection_size = 1
 
     def prepare(self, context):
         settings = context.scene.shapecorr

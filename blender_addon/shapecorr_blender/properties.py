@@ -4,8 +4,9 @@ import bpy
 
 from .shapecorr import options as library_options
 
-_DEFAULTS = {name: default for name, _kind, _doc, default in library_options()}
-_DOCS = {name: doc for name, _kind, doc, _default in library_options()}
+_OPTIONS = library_options()
+_DEFAULTS = {name: default for name, _kind, _doc, default in _OPTIONS}
+_DOCS = {name: doc for name, _kind, doc, _default in _OPTIONS}
 
 
 class ShapecorrSettings(bpy.types.PropertyGroup):

@@ -84,6 +84,25 @@ unsafe fn get(
     Ok(params.params.option(name)?)
 }
 
+/// Reads option `name` of type `wanted` into `*out_value` (nothing written on error).
+unsafe fn get_into<T>(
+    params: *const ScParams,
+    name: *const c_char,
+    out_value: *mut T,
+    wanted: OptionType,
+    extract: impl FnOnce(OptionValue) -> Option<T>,
+) -> ScStatus {
+    boundary(|| {
+        let out = out_value
+            .as_mut()
+            .ok_or_else(|| Failure::null("out_value"))?;
+        if let Some(value) = extract(get(params, name, wanted)?) {
+            *out = value;
+        }
+        Ok(())
+    })
+}
+
 fn type_name(t: OptionType) -> &'static str {
     match t {
         OptionType::Int => "an integer",
@@ -153,14 +172,9 @@ pub unsafe extern "C" fn sc_params_get_int(
     name: *const c_char,
     out_value: *mut i64,
 ) -> ScStatus {
-    boundary(|| {
-        let out = out_value
-            .as_mut()
-            .ok_or_else(|| Failure::null("out_value"))?;
-        if let OptionValue::Int(v) = get(params, name, OptionType::Int)? {
-            *out = v;
-        }
-        Ok(())
+    get_into(params, name, out_value, OptionType::Int, |v| match v {
+        OptionValue::Int(v) => Some(v),
+        _ => None,
     })
 }
 
@@ -174,14 +188,9 @@ pub unsafe extern "C" fn sc_params_get_double(
     name: *const c_char,
     out_value: *mut f64,
 ) -> ScStatus {
-    boundary(|| {
-        let out = out_value
-            .as_mut()
-            .ok_or_else(|| Failure::null("out_value"))?;
-        if let OptionValue::Float(v) = get(params, name, OptionType::Float)? {
-            *out = v;
-        }
-        Ok(())
+    get_into(params, name, out_value, OptionType::Float, |v| match v {
+        OptionValue::Float(v) => Some(v),
+        _ => None,
     })
 }
 
@@ -195,14 +204,9 @@ pub unsafe extern "C" fn sc_params_get_bool(
     name: *const c_char,
     out_value: *mut bool,
 ) -> ScStatus {
-    boundary(|| {
-        let out = out_value
-            .as_mut()
-            .ok_or_else(|| Failure::null("out_value"))?;
-        if let OptionValue::Bool(v) = get(params, name, OptionType::Bool)? {
-            *out = v;
-        }
-        Ok(())
+    get_into(params, name, out_value, OptionType::Bool, |v| match v {
+        OptionValue::Bool(v) => Some(v),
+        _ => None,
     })
 }
 
