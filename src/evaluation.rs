@@ -133,6 +133,98 @@ pub fn score(
     }
 }
 
+/// Geodesic distances on A between pairs of its vertices `(source, target)`, divided by
+/// `sqrt(area of A)` (the paper's normalisation): one heat-method solve per distinct
+/// source, so every map scored against the same ground truth shares the solves.
+pub fn normalised_geodesic_distances(
+    heat_a: &crate::geodesic::HeatGeodesics,
+    input_area_a: f64,
+    pairs: &[(u32, u32)],
+) -> crate::Result<Vec<f64>> {
+    let mut order: Vec<usize> = (0..pairs.len()).collect();
+    order.sort_by_key(|&i| pairs[i].0);
+    let scale = 1.0 / input_area_a.sqrt();
+    let mut out = vec![0.0; pairs.len()];
+    let mut start = 0;
+    while start < order.len() {
+        let source = pairs[order[start]].0;
+        let end = start
+            + order[start..]
+                .iter()
+                .take_while(|&&i| pairs[i].0 == source)
+                .count();
+        let field = heat_a.distances(&[source])?;
+        for &i in &order[start..end] {
+            out[i] = field[pairs[i].1 as usize] * scale;
+        }
+        start = end;
+    }
+    Ok(out)
+}
+
+/// Geodesic errors of pointwise maps from B to A against ground-truth pairs
+/// `(vertex of A, vertex of B)`: for each map and each pair `(x, y)`, the normalised
+/// geodesic distance on A from `x` to `p2p_ba[y]`.
+pub fn pointwise_errors(
+    heat_a: &crate::geodesic::HeatGeodesics,
+    input_area_a: f64,
+    truth: &[(u32, u32)],
+    maps_ba: &[&[u32]],
+) -> crate::Result<Vec<Vec<f64>>> {
+    let mut pairs = Vec::with_capacity(truth.len() * maps_ba.len());
+    for map in maps_ba {
+        if let Some(&(_, y)) = truth.iter().find(|&&(_, y)| y as usize >= map.len()) {
+            return Err(crate::Error::InvalidParameter {
+                name: "map",
+                reason: format!(
+                    "the map has {} entries but the ground truth names vertex {y} of B",
+                    map.len()
+                ),
+            });
+        }
+        pairs.extend(truth.iter().map(|&(x, y)| (x, map[y as usize])));
+    }
+    let distances = normalised_geodesic_distances(heat_a, input_area_a, &pairs)?;
+    Ok(distances
+        .chunks(truth.len().max(1))
+        .map(|c| c.to_vec())
+        .take(maps_ba.len())
+        .collect())
+}
+
+/// Summary of one map's geodesic errors.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ErrorSummary {
+    /// Mean normalised geodesic error.
+    pub mean: f64,
+    /// Fraction of pairs with error at most 0.05 and at most 0.10.
+    pub within_005: f64,
+    pub within_010: f64,
+}
+
+impl ErrorSummary {
+    pub fn of(errors: &[f64]) -> ErrorSummary {
+        let n = errors.len().max(1) as f64;
+        let within = |t: f64| errors.iter().filter(|&&e| e <= t).count() as f64 / n;
+        ErrorSummary {
+            mean: errors.iter().sum::<f64>() / n,
+            within_005: within(0.05),
+            within_010: within(0.10),
+        }
+    }
+}
+
+/// The cumulative error curve: for each threshold, the fraction of errors at most it.
+pub fn error_curve(errors: &[f64], thresholds: &[f64]) -> Vec<f64> {
+    let mut sorted = errors.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len().max(1) as f64;
+    thresholds
+        .iter()
+        .map(|&t| sorted.partition_point(|&e| e <= t) as f64 / n)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

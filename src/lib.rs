@@ -35,6 +35,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bench;
+pub mod bench_pointwise;
 pub mod correspondence;
 pub mod datasets;
 pub mod descriptors;
@@ -42,6 +43,7 @@ pub mod eigen;
 pub mod error;
 pub mod evaluation;
 pub mod ffi;
+pub mod fmap;
 pub mod geodesic;
 pub mod graph;
 pub mod io;
@@ -49,6 +51,8 @@ pub mod laplacian;
 pub mod matching;
 pub mod neighbors;
 pub mod options;
+pub mod plot;
+pub mod pointwise;
 pub mod progress;
 pub mod segmentation;
 pub mod shape;

@@ -7,9 +7,14 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use serde_json::json;
+use shapecorr::bench_pointwise::PairScores;
 use shapecorr::correspondence::{region_colors, Correspondence, Params, Symmetry};
 use shapecorr::evaluation::score_correspondence;
+use shapecorr::fmap::ZoomOutParams;
 use shapecorr::graph::ShapeGraph;
+use shapecorr::pointwise::{
+    coordinate_colors, PointwiseCorrespondence, PointwiseParams, Refinement, RegionConstraints,
+};
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
 use shapecorr::{EigenParams, Eigenbasis, Error, Laplacian, Shape, ShapeKind};
@@ -112,6 +117,23 @@ enum Command {
         #[command(flatten)]
         method: MethodArgs,
     },
+    /// Point-to-point map from B to A (regions, functional map, ZoomOut): writes
+    /// DIR/map_b_to_a.txt (for every vertex of B, the 0-based index of its vertex on A),
+    /// DIR/result.json (the regions as `match`, plus timings), DIR/a_colors.ply (A coloured
+    /// by its normalised coordinates) and DIR/b_mapped.ply (B with A's colours carried over
+    /// by the map).
+    P2p {
+        a: PathBuf,
+        b: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long)]
+        points: bool,
+        #[command(flatten)]
+        method: MethodArgs,
+        #[command(flatten)]
+        pointwise: PointwiseArgs,
+    },
     /// Benchmarks on the research datasets.
     Bench {
         #[command(subcommand)]
@@ -129,6 +151,8 @@ enum Command {
     },
 }
 
+// Parsed once per run: the size difference between variants does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum BenchCommand {
     /// Region accuracy over a pair list (like the paper's Table 1).
@@ -145,6 +169,145 @@ enum BenchCommand {
         #[command(flatten)]
         method: MethodArgs,
     },
+    /// Pointwise maps over a pair list (like the paper's Table 2 and FAUST curves): WKS, HKS,
+    /// regions, regions + WKS, symmetric regions, regions + ZoomOut.
+    P2p {
+        /// Dataset root (default: $SHAPECORR_DATA or ../shared/data).
+        #[arg(long)]
+        data: Option<PathBuf>,
+        /// Pair list (faust.txt, tosca.txt or tosca_r.txt; the layout follows the name).
+        #[arg(long)]
+        pairs: PathBuf,
+        /// Only the first N pairs.
+        #[arg(long)]
+        limit: Option<usize>,
+        /// Ground-truth pairs scored per shape pair (a seeded sample; 0 = all).
+        #[arg(long, default_value_t = 1000)]
+        samples: usize,
+        /// Write the cumulative error curves here (CSV, plus a PNG beside it).
+        #[arg(long)]
+        curves: Option<PathBuf>,
+        /// Write every pair's scores here (JSON).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Only these methods (comma separated; default: all).
+        #[arg(long, value_delimiter = ',')]
+        methods: Option<Vec<String>>,
+        #[command(flatten)]
+        method: MethodArgs,
+        #[command(flatten)]
+        pointwise: PointwiseArgs,
+    },
+    /// Scores maps computed elsewhere, stored as MAPS/{source}__{target}.txt (for every
+    /// vertex of the target, the 0-based index of its vertex on the source), with the same
+    /// geodesic error as `bench p2p`.
+    Maps {
+        #[arg(long)]
+        data: Option<PathBuf>,
+        #[arg(long)]
+        pairs: PathBuf,
+        #[arg(long)]
+        maps: PathBuf,
+        #[arg(long)]
+        limit: Option<usize>,
+        #[arg(long, default_value_t = 1000)]
+        samples: usize,
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+/// Parameters of the pointwise map; defaults come from `PointwiseParams::default()`.
+#[derive(clap::Args, Clone, Default)]
+struct PointwiseArgs {
+    /// Size of the first functional map.
+    #[arg(long)]
+    fmap_size: Option<usize>,
+    /// Final basis size of ZoomOut.
+    #[arg(long)]
+    zoomout_end: Option<usize>,
+    /// Eigenfunctions added per ZoomOut iteration.
+    #[arg(long)]
+    zoomout_step: Option<usize>,
+    /// Vertices per shape on which ZoomOut iterates (0 = all).
+    #[arg(long)]
+    zoomout_sample: Option<usize>,
+    /// Weight of the Laplacian commutativity term.
+    #[arg(long)]
+    laplacian_weight: Option<f64>,
+    /// Diffusion times of the region indicators, comma separated.
+    #[arg(long, value_delimiter = ',')]
+    region_times: Option<Vec<f64>>,
+    /// Refinement: zoomout, icp or none.
+    #[arg(long)]
+    refine: Option<String>,
+    /// Region constraints: one-to-one, symmetric or none.
+    #[arg(long)]
+    regions: Option<String>,
+    /// Add WKS descriptors.
+    #[arg(long)]
+    wks: bool,
+    /// Leave out the region distance functions.
+    #[arg(long)]
+    no_region_distances: bool,
+}
+
+impl PointwiseArgs {
+    fn params(&self) -> Result<PointwiseParams, Error> {
+        let mut p = PointwiseParams::default();
+        if let Some(v) = self.fmap_size {
+            p.fmap_size = v;
+        }
+        let mut zoom = match &p.refinement {
+            Refinement::ZoomOut(z) => z.clone(),
+            _ => ZoomOutParams::default(),
+        };
+        if let Some(v) = self.zoomout_end {
+            zoom.k_end = v;
+        }
+        if let Some(v) = self.zoomout_step {
+            zoom.step = v;
+        }
+        if let Some(v) = self.zoomout_sample {
+            zoom.sample_size = v;
+        }
+        p.refinement = match self.refine.as_deref() {
+            None | Some("zoomout") => Refinement::ZoomOut(zoom),
+            Some("icp") => Refinement::Icp(10),
+            Some("none") => Refinement::None,
+            Some(other) => {
+                return Err(Error::InvalidParameter {
+                    name: "refine",
+                    reason: format!("expected zoomout, icp or none, got {other:?}"),
+                })
+            }
+        };
+        p.regions = match self.regions.as_deref() {
+            None | Some("one-to-one") => RegionConstraints::OneToOne,
+            Some("symmetric") => RegionConstraints::Symmetric,
+            Some("none") => RegionConstraints::None,
+            Some(other) => {
+                return Err(Error::InvalidParameter {
+                    name: "regions",
+                    reason: format!("expected one-to-one, symmetric or none, got {other:?}"),
+                })
+            }
+        };
+        if let Some(v) = self.laplacian_weight {
+            p.laplacian_weight = v;
+        }
+        if let Some(v) = &self.region_times {
+            p.region_times = v.clone();
+        }
+        if self.wks {
+            p.wks = Some(Default::default());
+        }
+        if self.no_region_distances {
+            p.region_distances = false;
+        }
+        p.validate()?;
+        Ok(p)
+    }
 }
 
 /// The main parameters of the method; defaults come from `Params::default()`.
@@ -259,6 +422,16 @@ fn main() -> ExitCode {
             points,
             method,
         } => symmetry_command(&a, &out, points, &method.params()),
+        Command::P2p {
+            a,
+            b,
+            out,
+            points,
+            method,
+            pointwise,
+        } => pointwise
+            .params()
+            .and_then(|p| p2p_command(&a, &b, &out, points, &method.params(), &p)),
         Command::Bench {
             which:
                 BenchCommand::Regions {
@@ -268,6 +441,43 @@ fn main() -> ExitCode {
                     method,
                 },
         } => bench_regions_command(data, &pairs, limit, &method.params()),
+        Command::Bench {
+            which:
+                BenchCommand::P2p {
+                    data,
+                    pairs,
+                    limit,
+                    samples,
+                    curves,
+                    json,
+                    methods,
+                    method,
+                    pointwise,
+                },
+        } => pointwise.params().and_then(|p| {
+            bench_p2p_command(
+                data,
+                &pairs,
+                limit,
+                samples,
+                methods.as_deref(),
+                curves.as_deref(),
+                json.as_deref(),
+                &method.params(),
+                &p,
+            )
+        }),
+        Command::Bench {
+            which:
+                BenchCommand::Maps {
+                    data,
+                    pairs,
+                    maps,
+                    limit,
+                    samples,
+                    json,
+                },
+        } => bench_maps_command(data, &pairs, &maps, limit, samples, json.as_deref()),
         Command::Demo { out, vertices } => demo(&out, vertices),
     };
     match result {
@@ -664,6 +874,218 @@ fn bench_regions_command(
         started.elapsed().as_secs_f64()
     );
     print!("{}", shapecorr::bench::summary_table(&results));
+    Ok(())
+}
+
+fn p2p_command(
+    a: &Path,
+    b: &Path,
+    out: &Path,
+    points: bool,
+    params: &Params,
+    pointwise: &PointwiseParams,
+) -> Result<(), Error> {
+    let shape_a = Shape::read(a, points)?;
+    let shape_b = Shape::read(b, points)?;
+    std::fs::create_dir_all(out).map_err(|e| Error::file(out, e.to_string()))?;
+    let result = PointwiseCorrespondence::compute(
+        &shape_a,
+        &shape_b,
+        params,
+        pointwise,
+        &mut TerminalProgress,
+    );
+    end_progress_line();
+    let result = result?;
+    let map = &result.map.p2p_ba;
+    let mut text = String::with_capacity(map.len() * 6);
+    for v in map {
+        text.push_str(&v.to_string());
+        text.push('\n');
+    }
+    let map_path = out.join("map_b_to_a.txt");
+    std::fs::write(&map_path, text).map_err(|e| Error::file(&map_path, e.to_string()))?;
+    let mut value = correspondence_json(&shape_a, &shape_b, &result.regions);
+    value["timings_s"] = json!({
+        "eigenbasis_a": result.eigenbasis_a,
+        "eigenbasis_b": result.eigenbasis_b,
+        "regions": result.regions.timings,
+        "pointwise": result.map.timings,
+        "total": result.total,
+    });
+    value["fmap_size"] = json!(result.map.fmap_ab.nrows());
+    write_json(&out.join("result.json"), &value)?;
+    write_colored(out, &shape_a, &shape_b, &result.regions)?;
+    let colors_a = coordinate_colors(shape_a.vertices());
+    let colors_b: Vec<[u8; 3]> = map.iter().map(|&v| colors_a[v as usize]).collect();
+    shapecorr::io::write_ply(
+        &out.join("a_colors.ply"),
+        shape_a.vertices(),
+        shape_a.triangles(),
+        Some(&colors_a),
+    )?;
+    shapecorr::io::write_ply(
+        &out.join("b_mapped.ply"),
+        shape_b.vertices(),
+        shape_b.triangles(),
+        Some(&colors_b),
+    )?;
+    println!(
+        "map of {} vertices of B onto A ({} one-to-one region matches, functional map {}x{}); {:.2} s -> {}",
+        map.len(),
+        result.regions.matches_one_to_one.len(),
+        result.map.fmap_ab.nrows(),
+        result.map.fmap_ab.ncols(),
+        result.total,
+        out.display()
+    );
+    Ok(())
+}
+
+fn print_pair_scores(i: usize, n: usize, r: &PairScores) {
+    let scores: Vec<String> = r
+        .scores
+        .iter()
+        .map(|s| match s.error_mirrored {
+            Some(m) => format!("{} {:.4} (flip {:.4})", s.method, s.error.mean, m.mean),
+            None => format!("{} {:.4}", s.method, s.error.mean),
+        })
+        .collect();
+    eprintln!(
+        "[{}/{}] {} -> {} ({}): {}",
+        i + 1,
+        n,
+        r.source,
+        r.target,
+        r.category,
+        scores.join(", ")
+    );
+}
+
+fn write_scores_json(path: &Path, results: &[PairScores]) -> Result<(), Error> {
+    let pairs: Vec<serde_json::Value> = results
+        .iter()
+        .flat_map(|r| {
+            r.scores.iter().map(move |s| {
+                json!({
+                    "source": r.source,
+                    "target": r.target,
+                    "category": r.category,
+                    "method": s.method,
+                    "mean_error": s.error.mean,
+                    "mean_error_flip": s.error_mirrored.map(|_| s.best_mean()),
+                    "flipped": s.flipped(),
+                    "within_005": s.error.within_005,
+                    "within_010": s.error.within_010,
+                    "seconds": s.seconds,
+                })
+            })
+        })
+        .collect();
+    write_json(
+        path,
+        &json!({ "version": env!("CARGO_PKG_VERSION"), "pairs": pairs }),
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn bench_p2p_command(
+    data: Option<PathBuf>,
+    pairs: &Path,
+    limit: Option<usize>,
+    samples: usize,
+    only: Option<&[String]>,
+    curves: Option<&Path>,
+    json_path: Option<&Path>,
+    params: &Params,
+    pointwise: &PointwiseParams,
+) -> Result<(), Error> {
+    let root = data.unwrap_or_else(shapecorr::datasets::default_data_root);
+    let started = Instant::now();
+    let results = shapecorr::bench_pointwise::bench_pointwise(
+        &root,
+        pairs,
+        params,
+        pointwise,
+        samples,
+        only,
+        limit,
+        &mut print_pair_scores,
+    )?;
+    println!(
+        "shapecorr {} bench p2p --pairs {} ({} pairs, {} samples per pair, {:.0} s wall)",
+        env!("CARGO_PKG_VERSION"),
+        pairs.display(),
+        results.len(),
+        samples,
+        started.elapsed().as_secs_f64()
+    );
+    print!("{}", shapecorr::bench_pointwise::pointwise_table(&results));
+    if let Some(path) = json_path {
+        write_scores_json(path, &results)?;
+    }
+    if let Some(path) = curves {
+        let thresholds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.0025).collect();
+        let (methods, curves, csv) = shapecorr::bench_pointwise::curves_csv(&results, &thresholds);
+        std::fs::write(path, csv).map_err(|e| Error::file(path, e.to_string()))?;
+        let series: Vec<shapecorr::plot::Series> = methods
+            .iter()
+            .zip(&curves)
+            .map(|(m, c)| shapecorr::plot::Series {
+                label: m.clone(),
+                points: thresholds.iter().copied().zip(c.iter().copied()).collect(),
+            })
+            .collect();
+        let title = format!(
+            "{} ({} pairs): fraction of vertices within a geodesic error",
+            pairs
+                .file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned()),
+            results.len()
+        );
+        let png = path.with_extension("png");
+        let rendered = shapecorr::plot::line_chart_png(
+            &png,
+            &shapecorr::plot::Chart {
+                title: &title,
+                x_label: "geodesic error / sqrt(area) (flip allowed where a mirror map exists)",
+                y_label: "fraction of vertices",
+                x_range: (0.0, 0.25),
+                y_range: (0.0, 1.0),
+            },
+            &series,
+        )?;
+        if rendered.font.is_none() {
+            eprintln!(
+                "shapecorr: no font found, {} has no text (set SHAPECORR_FONT)",
+                png.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn bench_maps_command(
+    data: Option<PathBuf>,
+    pairs: &Path,
+    maps: &Path,
+    limit: Option<usize>,
+    samples: usize,
+    json_path: Option<&Path>,
+) -> Result<(), Error> {
+    let root = data.unwrap_or_else(shapecorr::datasets::default_data_root);
+    let results = shapecorr::bench_pointwise::bench_map_files(
+        &root,
+        pairs,
+        maps,
+        samples,
+        limit,
+        &mut print_pair_scores,
+    )?;
+    print!("{}", shapecorr::bench_pointwise::pointwise_table(&results));
+    if let Some(path) = json_path {
+        write_scores_json(path, &results)?;
+    }
     Ok(())
 }
 

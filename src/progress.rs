@@ -17,6 +17,8 @@ pub enum Stage {
     Matching = 5,
     /// Symmetry breaking (one-to-one region correspondence).
     SymmetryBreaking = 6,
+    /// Point-to-point map (functional map and its refinement).
+    PointwiseMap = 7,
 }
 
 /// Receives progress and may cancel: `report` returns `false` to stop the work, which then

@@ -1,0 +1,467 @@
+//! Pointwise-map benchmark over a pair list (`shapecorr bench p2p`, the paper's Table 2 and
+//! FAUST error curves), and the scoring of maps computed elsewhere (`shapecorr bench maps`,
+//! for comparisons with other tools on the same geodesic error).
+//!
+//! Error: for a sample of the ground-truth pairs `(x on A, y on B)` (seeded, the same for
+//! every method), the geodesic distance on A between `x` and the map's image of `y`,
+//! divided by `sqrt(area of A)`; geodesics by the heat method (within 2% of exact on a
+//! sphere and a grid). Where a mirror map exists, the error against the mirrored ground
+//! truth is computed too, and the better of the two is reported beside the plain one.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+use crate::correspondence::{Correspondence, Params};
+use crate::datasets::{read_pairs, Layout, Pair};
+use crate::descriptors::WksParams;
+use crate::eigen::{EigenParams, Eigenbasis};
+use crate::evaluation::{pointwise_errors, ErrorSummary};
+use crate::geodesic::HeatGeodesics;
+use crate::pointwise::{truncated, PointwiseMap, PointwiseParams, Refinement, RegionConstraints};
+use crate::progress::NoProgress;
+use crate::shape::Shape;
+use crate::{Error, Result};
+
+/// Seed of the ground-truth sample.
+const SAMPLE_SEED: u64 = 0x9e0d;
+
+/// The methods of the paper's Table 2 plus the refined one: name and parameters, all
+/// derived from `base` (the default pipeline, regions + ZoomOut).
+pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, PointwiseParams)> {
+    let plain = PointwiseParams {
+        refinement: Refinement::None,
+        ..base.clone()
+    };
+    let descriptors_only = PointwiseParams {
+        regions: RegionConstraints::None,
+        ..plain.clone()
+    };
+    vec![
+        (
+            "wks".into(),
+            PointwiseParams {
+                wks: Some(WksParams::default()),
+                ..descriptors_only.clone()
+            },
+        ),
+        (
+            "hks".into(),
+            PointwiseParams {
+                hks: Some(region_params.hks.clone()),
+                descriptor_step: 1,
+                ..descriptors_only.clone()
+            },
+        ),
+        ("regions".into(), plain.clone()),
+        (
+            "regions+wks".into(),
+            PointwiseParams {
+                wks: Some(WksParams::default()),
+                ..plain.clone()
+            },
+        ),
+        (
+            "symmetric".into(),
+            PointwiseParams {
+                regions: RegionConstraints::Symmetric,
+                ..plain.clone()
+            },
+        ),
+        ("regions+zoomout".into(), base.clone()),
+    ]
+}
+
+/// One method's scores on one pair.
+#[derive(Debug, Clone, Serialize)]
+pub struct MapScore {
+    pub method: String,
+    /// Against the ground truth.
+    pub error: ErrorSummary,
+    /// Against the mirrored ground truth, where a mirror map exists.
+    pub error_mirrored: Option<ErrorSummary>,
+    /// Seconds for the pair as if run alone (both eigenbases, the regions where used, the
+    /// map); 0 for maps scored from files.
+    pub seconds: f64,
+    /// The sampled errors (plain, or mirrored where that mean is lower), for the curves.
+    #[serde(skip)]
+    pub best_errors: Vec<f64>,
+}
+
+impl MapScore {
+    /// The better of the plain and the mirrored mean error.
+    pub fn best_mean(&self) -> f64 {
+        self.error_mirrored
+            .map_or(self.error.mean, |m| m.mean.min(self.error.mean))
+    }
+
+    /// True when the mirrored ground truth fits better.
+    pub fn flipped(&self) -> bool {
+        self.error_mirrored
+            .is_some_and(|m| m.mean < self.error.mean)
+    }
+}
+
+/// The scores of every method on one pair.
+#[derive(Debug, Clone, Serialize)]
+pub struct PairScores {
+    pub source: String,
+    pub target: String,
+    pub category: String,
+    pub scores: Vec<MapScore>,
+}
+
+/// Shapes, eigenbases and geodesic solvers, each made once per shape.
+struct ShapeCache {
+    layout: Layout,
+    root: std::path::PathBuf,
+    eigen: EigenParams,
+    shapes: BTreeMap<String, CachedShape>,
+}
+
+/// A shape with what has been computed for it so far.
+struct CachedShape {
+    shape: Shape,
+    /// The eigenbasis and the seconds it took.
+    basis: Option<(Eigenbasis, f64)>,
+    heat: Option<HeatGeodesics>,
+}
+
+impl ShapeCache {
+    fn load(&mut self, name: &str, basis: bool, heat: bool) -> Result<()> {
+        if !self.shapes.contains_key(name) {
+            let shape = Shape::read(&self.layout.shape_path(&self.root, name), false)?;
+            self.shapes.insert(
+                name.to_string(),
+                CachedShape {
+                    shape,
+                    basis: None,
+                    heat: None,
+                },
+            );
+        }
+        let entry = self.shapes.get_mut(name).expect("inserted above");
+        if basis && entry.basis.is_none() {
+            let t = Instant::now();
+            let b = Eigenbasis::compute(&entry.shape, &self.eigen)?;
+            entry.basis = Some((b, t.elapsed().as_secs_f64()));
+        }
+        if heat && entry.heat.is_none() {
+            entry.heat = Some(HeatGeodesics::new(&entry.shape)?);
+        }
+        Ok(())
+    }
+}
+
+/// Scores maps `p2p_ba` of one pair against its ground truth (a seeded sample of at most
+/// `samples` pairs; 0 = all).
+fn score_maps(
+    cache: &mut ShapeCache,
+    pair: &Pair,
+    maps: &[(String, Vec<u32>, f64)],
+    samples: usize,
+) -> Result<Vec<MapScore>> {
+    cache.load(&pair.source, false, true)?;
+    cache.load(&pair.target, false, false)?;
+    let n_a = cache.shapes[&pair.source].shape.n_vertices();
+    let n_b = cache.shapes[&pair.target].shape.n_vertices();
+    for (name, map, _) in maps {
+        if map.len() != n_b {
+            return Err(Error::InvalidParameter {
+                name: "map",
+                reason: format!(
+                    "{name}: {} entries for the {n_b} vertices of {}",
+                    map.len(),
+                    pair.target
+                ),
+            });
+        }
+        if let Some(v) = map.iter().find(|&&v| v as usize >= n_a) {
+            return Err(Error::InvalidParameter {
+                name: "map",
+                reason: format!(
+                    "{name}: vertex {v} is out of range for {} ({n_a} vertices)",
+                    pair.source
+                ),
+            });
+        }
+    }
+    let (truth, mirrored) =
+        cache
+            .layout
+            .ground_truth(&cache.root, &pair.source, &pair.target, n_a, n_b)?;
+    let mut chosen: Vec<usize> = (0..truth.len()).collect();
+    if samples > 0 && samples < truth.len() {
+        chosen.shuffle(&mut ChaCha8Rng::seed_from_u64(SAMPLE_SEED));
+        chosen.truncate(samples);
+        chosen.sort_unstable();
+    }
+    let pick = |t: &[(u32, u32)]| chosen.iter().map(|&i| t[i]).collect::<Vec<_>>();
+    let entry = &cache.shapes[&pair.source];
+    let heat = entry.heat.as_ref().expect("loaded above");
+    let area_a = shape_area(&entry.shape)?;
+    let map_refs: Vec<&[u32]> = maps.iter().map(|(_, m, _)| m.as_slice()).collect();
+    let plain = pointwise_errors(heat, area_a, &pick(&truth), &map_refs)?;
+    let flipped = match &mirrored {
+        Some(m) => Some(pointwise_errors(heat, area_a, &pick(m), &map_refs)?),
+        None => None,
+    };
+    Ok(maps
+        .iter()
+        .enumerate()
+        .map(|(i, (name, _, seconds))| {
+            let error = ErrorSummary::of(&plain[i]);
+            let error_mirrored = flipped.as_ref().map(|f| ErrorSummary::of(&f[i]));
+            let best_errors = match (&flipped, error_mirrored) {
+                (Some(f), Some(m)) if m.mean < error.mean => f[i].clone(),
+                _ => plain[i].clone(),
+            };
+            MapScore {
+                method: name.clone(),
+                error,
+                error_mirrored,
+                seconds: *seconds,
+                best_errors,
+            }
+        })
+        .collect())
+}
+
+/// The area of a shape in its own units (the unit-area scale of the errors).
+fn shape_area(shape: &Shape) -> Result<f64> {
+    Ok(crate::laplacian::Laplacian::new(shape)?.input_area)
+}
+
+#[allow(clippy::too_many_arguments)]
+/// Runs every method of [`methods`] on the pairs of `pairs_file` (layout from its name).
+/// `samples` ground-truth pairs per shape pair are scored (0 = all). `report` is called
+/// after every pair.
+pub fn bench_pointwise(
+    root: &Path,
+    pairs_file: &Path,
+    params: &Params,
+    pointwise: &PointwiseParams,
+    samples: usize,
+    only: Option<&[String]>,
+    limit: Option<usize>,
+    report: &mut dyn FnMut(usize, usize, &PairScores),
+) -> Result<Vec<PairScores>> {
+    let layout = Layout::from_pairs_file(pairs_file)?;
+    let mut pairs = read_pairs(pairs_file)?;
+    if let Some(limit) = limit {
+        pairs.truncate(limit);
+    }
+    let mut methods = methods(pointwise, params);
+    if let Some(only) = only {
+        if let Some(unknown) = only.iter().find(|o| !methods.iter().any(|(m, _)| m == *o)) {
+            return Err(Error::InvalidParameter {
+                name: "methods",
+                reason: format!(
+                    "unknown method {unknown:?}; known: {}",
+                    methods
+                        .iter()
+                        .map(|(m, _)| m.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            });
+        }
+        methods.retain(|(m, _)| only.contains(m));
+    }
+    let mut cache = ShapeCache {
+        layout,
+        root: root.to_path_buf(),
+        eigen: EigenParams {
+            n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
+            ..params.eigen.clone()
+        },
+        shapes: BTreeMap::new(),
+    };
+    let mut results = Vec::with_capacity(pairs.len());
+    for (index, pair) in pairs.iter().enumerate() {
+        cache.load(&pair.source, true, false)?;
+        cache.load(&pair.target, true, false)?;
+        let (a, b) = (&cache.shapes[&pair.source], &cache.shapes[&pair.target]);
+        let (basis_a, basis_b) = (
+            a.basis.as_ref().expect("loaded"),
+            b.basis.as_ref().expect("loaded"),
+        );
+        let (a, b) = (&a.shape, &b.shape);
+        let eigen_seconds = basis_a.1 + basis_b.1;
+        let t = Instant::now();
+        let regions = Correspondence::from_bases(
+            a,
+            &truncated(&basis_a.0, params.eigen.n_eigenpairs),
+            b,
+            &truncated(&basis_b.0, params.eigen.n_eigenpairs),
+            params,
+            &mut NoProgress,
+        )?;
+        let region_seconds = t.elapsed().as_secs_f64();
+        let mut maps = Vec::with_capacity(methods.len());
+        for (name, method) in &methods {
+            let t = Instant::now();
+            let map =
+                PointwiseMap::from_bases(a, &basis_a.0, b, &basis_b.0, Some(&regions), method)?;
+            let uses_regions = method.regions != RegionConstraints::None;
+            let seconds = t.elapsed().as_secs_f64()
+                + eigen_seconds
+                + if uses_regions { region_seconds } else { 0.0 };
+            maps.push((name.clone(), map.p2p_ba, seconds));
+        }
+        let scores = score_maps(&mut cache, pair, &maps, samples)?;
+        let outcome = PairScores {
+            source: pair.source.clone(),
+            target: pair.target.clone(),
+            category: pair.category.clone(),
+            scores,
+        };
+        report(index, pairs.len(), &outcome);
+        results.push(outcome);
+    }
+    Ok(results)
+}
+
+/// Scores maps stored as files `maps_dir/{source}__{target}.txt` (one 0-based vertex of A
+/// per line, for every vertex of B) on the pairs of `pairs_file`.
+pub fn bench_map_files(
+    root: &Path,
+    pairs_file: &Path,
+    maps_dir: &Path,
+    samples: usize,
+    limit: Option<usize>,
+    report: &mut dyn FnMut(usize, usize, &PairScores),
+) -> Result<Vec<PairScores>> {
+    let layout = Layout::from_pairs_file(pairs_file)?;
+    let mut pairs = read_pairs(pairs_file)?;
+    if let Some(limit) = limit {
+        pairs.truncate(limit);
+    }
+    let mut cache = ShapeCache {
+        layout,
+        root: root.to_path_buf(),
+        eigen: EigenParams::default(),
+        shapes: BTreeMap::new(),
+    };
+    let name = maps_dir
+        .file_name()
+        .map_or("map".to_string(), |n| n.to_string_lossy().into_owned());
+    let mut results = Vec::with_capacity(pairs.len());
+    for (index, pair) in pairs.iter().enumerate() {
+        let path = maps_dir.join(format!("{}__{}.txt", pair.source, pair.target));
+        let map = read_map(&path)?;
+        let scores = score_maps(&mut cache, pair, &[(name.clone(), map, 0.0)], samples)?;
+        let outcome = PairScores {
+            source: pair.source.clone(),
+            target: pair.target.clone(),
+            category: pair.category.clone(),
+            scores,
+        };
+        report(index, pairs.len(), &outcome);
+        results.push(outcome);
+    }
+    Ok(results)
+}
+
+/// Reads a map file: one 0-based vertex index per line.
+pub fn read_map(path: &Path) -> Result<Vec<u32>> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e.to_string()))?;
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(n, l)| {
+            l.trim().parse::<u32>().map_err(|_| {
+                Error::file(
+                    path,
+                    format!("line {}: expected a vertex index, got {l:?}", n + 1),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Per category and method: mean error, the better of plain and mirrored (with how many
+/// pairs the mirror won), the fractions within 0.05 and 0.10, and seconds per pair.
+pub fn pointwise_table(results: &[PairScores]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "| category | method | pairs | mean error | mean error (flip ok) | flipped pairs | within 0.05 | within 0.10 | s/pair |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|");
+    let mut categories: BTreeMap<&str, Vec<&PairScores>> = BTreeMap::new();
+    for r in results {
+        categories.entry(r.category.as_str()).or_default().push(r);
+    }
+    let all: Vec<&PairScores> = results.iter().collect();
+    let methods: Vec<String> = results
+        .first()
+        .map(|r| r.scores.iter().map(|s| s.method.clone()).collect())
+        .unwrap_or_default();
+    let rows = categories
+        .iter()
+        .map(|(c, v)| (c.to_string(), v.clone()))
+        .chain(std::iter::once(("all".to_string(), all)));
+    for (category, rows) in rows {
+        for (m, method) in methods.iter().enumerate() {
+            let scores: Vec<&MapScore> = rows.iter().map(|r| &r.scores[m]).collect();
+            let n = scores.len() as f64;
+            let mean = |f: &dyn Fn(&MapScore) -> f64| scores.iter().map(|s| f(s)).sum::<f64>() / n;
+            let has_mirror = scores.iter().all(|s| s.error_mirrored.is_some());
+            let (flip, flipped) = if has_mirror {
+                (
+                    format!("{:.4}", mean(&|s| s.best_mean())),
+                    format!("{}", scores.iter().filter(|s| s.flipped()).count()),
+                )
+            } else {
+                ("n/a".into(), "n/a".into())
+            };
+            let _ = writeln!(
+                out,
+                "| {category} | {method} | {} | {:.4} | {flip} | {flipped} | {:.3} | {:.3} | {:.2} |",
+                scores.len(),
+                mean(&|s| s.error.mean),
+                mean(&|s| s.error.within_005),
+                mean(&|s| s.error.within_010),
+                mean(&|s| s.seconds),
+            );
+        }
+    }
+    out
+}
+
+/// Cumulative error curves over all pairs (flip allowed where a mirror map exists): one
+/// column per method, thresholds 0 to 0.25, as CSV text.
+pub fn curves_csv(
+    results: &[PairScores],
+    thresholds: &[f64],
+) -> (Vec<String>, Vec<Vec<f64>>, String) {
+    let methods: Vec<String> = results
+        .first()
+        .map(|r| r.scores.iter().map(|s| s.method.clone()).collect())
+        .unwrap_or_default();
+    let curves: Vec<Vec<f64>> = (0..methods.len())
+        .map(|m| {
+            let errors: Vec<f64> = results
+                .iter()
+                .flat_map(|r| r.scores[m].best_errors.iter().copied())
+                .collect();
+            crate::evaluation::error_curve(&errors, thresholds)
+        })
+        .collect();
+    let mut csv = format!("threshold,{}\n", methods.join(","));
+    for (i, t) in thresholds.iter().enumerate() {
+        let _ = write!(csv, "{t:.4}");
+        for c in &curves {
+            let _ = write!(csv, ",{:.5}", c[i]);
+        }
+        csv.push('\n');
+    }
+    (methods, curves, csv)
+}

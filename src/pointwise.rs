@@ -1,0 +1,509 @@
+//! Point-to-point maps from region correspondences (DESIGN.md step 13, paper section 6.4):
+//! the matched regions' indicator functions (optionally heat-diffused, optionally with WKS
+//! or HKS) constrain a functional map, which is converted to a vertex map and refined by
+//! ZoomOut (beyond the paper). See [`crate::fmap`] for the building blocks.
+//!
+//! Direction: the output `p2p_ba[v]` is the vertex of A matched to vertex `v` of B
+//! (`map_b_to_a.txt`); `fmap_ab` maps functions on A to functions on B.
+
+use std::time::Instant;
+
+use faer::Mat;
+use rayon::prelude::*;
+
+use crate::correspondence::{Correspondence, Params};
+use crate::descriptors::{hks, wks, HksParams, WksParams};
+use crate::eigen::{EigenParams, Eigenbasis};
+use crate::fmap::{fmap_to_p2p, icp_refine, project, solve_fmap, zoomout, ZoomOutParams};
+use crate::progress::{check, Progress, Stage};
+use crate::shape::Shape;
+use crate::{Error, Result};
+
+/// Which region matches constrain the functional map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RegionConstraints {
+    /// No region constraint (descriptors only).
+    None,
+    /// One indicator pair per one-to-one match (the paper's SEGS).
+    OneToOne,
+    /// One indicator pair per group of symmetric matches (connected component of the
+    /// bipartite match graph: the union of its regions on each side; the paper's SYM).
+    Symmetric,
+}
+
+/// How the first functional map is refined.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Refinement {
+    None,
+    /// ZoomOut (Melzi et al. 2019) up to `k_end` eigenfunctions.
+    ZoomOut(ZoomOutParams),
+    /// Spectral ICP (Ovsjanikov et al. 2012) for at most this many iterations.
+    Icp(usize),
+}
+
+/// Parameters of the pointwise map. The defaults are the documented ones.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointwiseParams {
+    /// Eigenpairs computed per shape (the largest basis any stage uses; region matching
+    /// uses the first [`Params::eigen`]`.n_eigenpairs` of them).
+    pub n_eigenpairs: usize,
+    /// Size of the first functional map (k x k).
+    pub fmap_size: usize,
+    /// Region constraints.
+    pub regions: RegionConstraints,
+    /// Heat-diffusion times of the region indicators on the unit-area shape (0 = the plain
+    /// indicator); each time adds one descriptor per region pair.
+    pub region_times: Vec<f64>,
+    /// Also constrain the map by each region set's distance function (edge-graph geodesic
+    /// distance from the set, on the unit-area shape).
+    pub region_distances: bool,
+    /// WKS descriptors (the paper's WKS and WKS + SEGS), every `descriptor_step`-th energy.
+    pub wks: Option<WksParams>,
+    /// HKS descriptors (the paper's HKS), every `descriptor_step`-th time.
+    pub hks: Option<HksParams>,
+    /// Keep every n-th WKS/HKS column (pyFM's `subsample_step`).
+    pub descriptor_step: usize,
+    /// Weight of the Laplacian commutativity term (eigenvalue differences normalised).
+    pub laplacian_weight: f64,
+    /// Refinement of the first map.
+    pub refinement: Refinement,
+}
+
+impl Default for PointwiseParams {
+    fn default() -> Self {
+        PointwiseParams {
+            n_eigenpairs: 100,
+            fmap_size: 40,
+            regions: RegionConstraints::OneToOne,
+            region_times: vec![0.0],
+            region_distances: true,
+            wks: None,
+            hks: None,
+            descriptor_step: 5,
+            laplacian_weight: 1.0,
+            refinement: Refinement::ZoomOut(ZoomOutParams::default()),
+        }
+    }
+}
+
+impl PointwiseParams {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name, reason: String| Err(Error::InvalidParameter { name, reason });
+        if self.fmap_size < 2 || self.fmap_size > self.n_eigenpairs {
+            return bad(
+                "pointwise.fmap_size",
+                format!(
+                    "need 2 <= fmap_size <= n_eigenpairs ({}), got {}",
+                    self.n_eigenpairs, self.fmap_size
+                ),
+            );
+        }
+        if self
+            .region_times
+            .iter()
+            .any(|t| !(*t >= 0.0 && t.is_finite()))
+        {
+            return bad(
+                "pointwise.region_times",
+                format!("need finite times >= 0, got {:?}", self.region_times),
+            );
+        }
+        if self.regions != RegionConstraints::None && self.region_times.is_empty() {
+            return bad(
+                "pointwise.region_times",
+                "region constraints need at least one time".into(),
+            );
+        }
+        if self.regions == RegionConstraints::None && self.wks.is_none() && self.hks.is_none() {
+            return bad(
+                "pointwise.descriptors",
+                "choose regions, WKS or HKS (none given)".into(),
+            );
+        }
+        if self.descriptor_step == 0 {
+            return bad("pointwise.descriptor_step", "must be at least 1".into());
+        }
+        if !(self.laplacian_weight >= 0.0 && self.laplacian_weight.is_finite()) {
+            return bad(
+                "pointwise.laplacian_weight",
+                format!("must be finite and >= 0, got {}", self.laplacian_weight),
+            );
+        }
+        match &self.refinement {
+            Refinement::ZoomOut(z)
+                if z.step == 0 || z.k_end < self.fmap_size || z.k_end > self.n_eigenpairs =>
+            {
+                bad(
+                    "pointwise.zoomout",
+                    format!(
+                        "need step >= 1 and fmap_size ({}) <= k_end ({}) <= n_eigenpairs ({})",
+                        self.fmap_size, z.k_end, self.n_eigenpairs
+                    ),
+                )
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Seconds per stage of the pointwise map.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct PointwiseTimings {
+    /// Descriptors and the first functional map.
+    pub fmap: f64,
+    /// Its conversion to a vertex map and the refinement.
+    pub refinement: f64,
+}
+
+/// A point-to-point map from B to A.
+#[derive(Debug, Clone)]
+pub struct PointwiseMap {
+    /// `p2p_ba[v]`: the vertex of A matched to vertex `v` of B.
+    pub p2p_ba: Vec<u32>,
+    /// The final functional map from A to B (`k x k`).
+    pub fmap_ab: Mat<f64>,
+    pub timings: PointwiseTimings,
+}
+
+impl PointwiseMap {
+    /// The pointwise map between two shapes whose eigenbases are given (each with at least
+    /// `params.n_eigenpairs` pairs, or all the shape has), with the region correspondence
+    /// `regions` (needed unless `params.regions` is `None`).
+    pub fn from_bases(
+        a: &Shape,
+        basis_a: &Eigenbasis,
+        b: &Shape,
+        basis_b: &Eigenbasis,
+        regions: Option<&Correspondence>,
+        params: &PointwiseParams,
+    ) -> Result<PointwiseMap> {
+        params.validate()?;
+        let started = Instant::now();
+        let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
+        let (mut coef_a, mut coef_b) = (Vec::new(), Vec::new());
+        if params.regions != RegionConstraints::None {
+            let regions = regions.ok_or(Error::InvalidParameter {
+                name: "regions",
+                reason: "region constraints need a region correspondence".into(),
+            })?;
+            let (fa, fb) = region_indicators(regions, params.regions);
+            if fa.ncols() == 0 {
+                return Err(Error::InvalidParameter {
+                    name: "regions",
+                    reason: "the region correspondence has no match to constrain the map".into(),
+                });
+            }
+            for &t in &params.region_times {
+                coef_a.push(diffused(basis_a, k, fa.as_ref(), t));
+                coef_b.push(diffused(basis_b, k, fb.as_ref(), t));
+            }
+            if params.region_distances {
+                let da = distance_functions(a, basis_a, fa.as_ref());
+                let db = distance_functions(b, basis_b, fb.as_ref());
+                coef_a.push(project(
+                    basis_a.vectors.as_ref(),
+                    &basis_a.mass,
+                    k,
+                    da.as_ref(),
+                ));
+                coef_b.push(project(
+                    basis_b.vectors.as_ref(),
+                    &basis_b.mass,
+                    k,
+                    db.as_ref(),
+                ));
+            }
+        }
+        if let Some(wks_params) = &params.wks {
+            coef_a.push(project_every(
+                basis_a,
+                k,
+                &wks(basis_a, wks_params)?,
+                params.descriptor_step,
+            ));
+            coef_b.push(project_every(
+                basis_b,
+                k,
+                &wks(basis_b, wks_params)?,
+                params.descriptor_step,
+            ));
+        }
+        if let Some(hks_params) = &params.hks {
+            coef_a.push(project_every(
+                basis_a,
+                k,
+                &hks(basis_a, hks_params)?,
+                params.descriptor_step,
+            ));
+            coef_b.push(project_every(
+                basis_b,
+                k,
+                &hks(basis_b, hks_params)?,
+                params.descriptor_step,
+            ));
+        }
+        let coef_a = normalised_columns(&coef_a);
+        let coef_b = normalised_columns(&coef_b);
+        let fmap = solve_fmap(
+            coef_a.as_ref(),
+            coef_b.as_ref(),
+            &basis_a.values,
+            &basis_b.values,
+            params.laplacian_weight,
+        )?;
+        let t_fmap = started.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+        let (fmap_ab, p2p_ba) = match &params.refinement {
+            Refinement::None => {
+                let p2p = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b);
+                (fmap, p2p)
+            }
+            Refinement::ZoomOut(z) => {
+                let z = ZoomOutParams {
+                    k_end: z.k_end.min(basis_a.len()).min(basis_b.len()),
+                    ..z.clone()
+                };
+                zoomout(
+                    fmap.as_ref(),
+                    phi_a,
+                    &basis_a.mass,
+                    phi_b,
+                    &basis_b.mass,
+                    &z,
+                )?
+            }
+            Refinement::Icp(iterations) => {
+                icp_refine(fmap.as_ref(), phi_a, phi_b, &basis_b.mass, *iterations)?
+            }
+        };
+        Ok(PointwiseMap {
+            p2p_ba,
+            fmap_ab,
+            timings: PointwiseTimings {
+                fmap: t_fmap,
+                refinement: t.elapsed().as_secs_f64(),
+            },
+        })
+    }
+}
+
+/// Everything from two shapes: eigenbases, region correspondence, pointwise map.
+#[derive(Debug, Clone)]
+pub struct PointwiseCorrespondence {
+    pub regions: Correspondence,
+    pub map: PointwiseMap,
+    /// Seconds for both eigenbases, the regions, the map, and the whole call.
+    pub eigenbasis_a: f64,
+    pub eigenbasis_b: f64,
+    pub total: f64,
+}
+
+impl PointwiseCorrespondence {
+    /// Region correspondence and pointwise map of two shapes. Each eigenbasis is computed
+    /// once, with `pointwise.n_eigenpairs` pairs; region matching uses its first
+    /// `params.eigen.n_eigenpairs`.
+    pub fn compute(
+        a: &Shape,
+        b: &Shape,
+        params: &Params,
+        pointwise: &PointwiseParams,
+        progress: &mut dyn Progress,
+    ) -> Result<PointwiseCorrespondence> {
+        params.validate()?;
+        pointwise.validate()?;
+        let started = Instant::now();
+        let eigen = EigenParams {
+            n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
+            ..params.eigen.clone()
+        };
+        let basis_a = Eigenbasis::compute_with_progress(a, &eigen, progress)?;
+        let eigenbasis_a = started.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let basis_b = Eigenbasis::compute_with_progress(b, &eigen, progress)?;
+        let eigenbasis_b = t.elapsed().as_secs_f64();
+        let regions = Correspondence::from_bases(
+            a,
+            &truncated(&basis_a, params.eigen.n_eigenpairs),
+            b,
+            &truncated(&basis_b, params.eigen.n_eigenpairs),
+            params,
+            progress,
+        )?;
+        check(progress, Stage::PointwiseMap, 0.0)?;
+        let map = PointwiseMap::from_bases(a, &basis_a, b, &basis_b, Some(&regions), pointwise)?;
+        check(progress, Stage::PointwiseMap, 1.0)?;
+        Ok(PointwiseCorrespondence {
+            regions,
+            map,
+            eigenbasis_a,
+            eigenbasis_b,
+            total: started.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+/// The first `k` eigenpairs of a basis (a copy; the eigenvectors of a larger solve agree
+/// with a smaller one's to round-off).
+pub fn truncated(basis: &Eigenbasis, k: usize) -> Eigenbasis {
+    let k = k.min(basis.len());
+    Eigenbasis {
+        values: basis.values[..k].to_vec(),
+        vectors: basis.vectors.subcols(0, k).to_owned(),
+        mass: basis.mass.clone(),
+        input_area: basis.input_area,
+    }
+}
+
+/// Indicator functions (columns) of corresponding region sets on A and B.
+pub fn region_indicators(
+    regions: &Correspondence,
+    kind: RegionConstraints,
+) -> (Mat<f64>, Mat<f64>) {
+    let groups: Vec<(Vec<u32>, Vec<u32>)> = match kind {
+        RegionConstraints::None => Vec::new(),
+        RegionConstraints::OneToOne => regions
+            .matches_one_to_one
+            .iter()
+            .map(|&(i, j)| (vec![i], vec![j]))
+            .collect(),
+        RegionConstraints::Symmetric => match_groups(&regions.matches),
+    };
+    let indicator = |labels: &[u32], n_regions: usize, a_side: bool| {
+        let mut member = vec![vec![false; n_regions]; groups.len()];
+        for (m, group) in member.iter_mut().zip(&groups) {
+            for &r in if a_side { &group.0 } else { &group.1 } {
+                m[r as usize] = true;
+            }
+        }
+        Mat::from_fn(labels.len(), groups.len(), |v, g| {
+            if member[g][labels[v] as usize] {
+                1.0
+            } else {
+                0.0
+            }
+        })
+    };
+    let fa = indicator(regions.regions_a(), regions.graph_a.n_nodes(), true);
+    let fb = indicator(regions.regions_b(), regions.graph_b.n_nodes(), false);
+    (fa, fb)
+}
+
+/// Connected components of the bipartite graph of symmetric matches, as (regions of A,
+/// regions of B), ordered by their smallest region of A.
+pub fn match_groups(matches: &[(u32, u32)]) -> Vec<(Vec<u32>, Vec<u32>)> {
+    let mut groups: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
+    for &(i, j) in matches {
+        let hits: Vec<usize> = (0..groups.len())
+            .filter(|&g| groups[g].0.contains(&i) || groups[g].1.contains(&j))
+            .collect();
+        let mut merged = (vec![i], vec![j]);
+        for &g in hits.iter().rev() {
+            let (a, b) = groups.remove(g);
+            merged.0.extend(a);
+            merged.1.extend(b);
+        }
+        merged.0.sort_unstable();
+        merged.0.dedup();
+        merged.1.sort_unstable();
+        merged.1.dedup();
+        groups.push(merged);
+    }
+    groups.sort();
+    groups
+}
+
+/// For every indicator column, the edge-graph distance from the vertices where it is 1
+/// (unit-area shape; unreachable vertices take the largest finite distance).
+fn distance_functions(
+    shape: &Shape,
+    basis: &Eigenbasis,
+    indicators: faer::MatRef<'_, f64>,
+) -> Mat<f64> {
+    let graph = crate::geodesic::EdgeGraph::new(shape, 1.0 / basis.input_area.sqrt());
+    let columns: Vec<Vec<f64>> = (0..indicators.ncols())
+        .into_par_iter()
+        .map(|g| {
+            let sources: Vec<u32> = (0..indicators.nrows())
+                .filter(|&v| indicators[(v, g)] > 0.0)
+                .map(|v| v as u32)
+                .collect();
+            let mut d = graph.distances(&sources);
+            let finite = d
+                .iter()
+                .copied()
+                .filter(|x| x.is_finite())
+                .fold(0.0, f64::max);
+            for x in &mut d {
+                if !x.is_finite() {
+                    *x = finite;
+                }
+            }
+            d
+        })
+        .collect();
+    Mat::from_fn(indicators.nrows(), columns.len(), |v, g| columns[g][v])
+}
+
+/// Coefficients of the functions after heat diffusion for time `t`: `exp(-lambda_i t)`
+/// times the projection.
+fn diffused(basis: &Eigenbasis, k: usize, functions: faer::MatRef<'_, f64>, t: f64) -> Mat<f64> {
+    let mut coef = project(basis.vectors.as_ref(), &basis.mass, k, functions);
+    for i in 0..coef.nrows() {
+        let decay = (-basis.values[i].max(0.0) * t).exp();
+        for j in 0..coef.ncols() {
+            coef[(i, j)] *= decay;
+        }
+    }
+    coef
+}
+
+/// Coefficients of every `step`-th descriptor column.
+fn project_every(basis: &Eigenbasis, k: usize, descriptors: &Mat<f64>, step: usize) -> Mat<f64> {
+    let columns: Vec<usize> = (0..descriptors.ncols()).step_by(step).collect();
+    let chosen = Mat::from_fn(descriptors.nrows(), columns.len(), |i, j| {
+        descriptors[(i, columns[j])]
+    });
+    project(basis.vectors.as_ref(), &basis.mass, k, chosen.as_ref())
+}
+
+/// The coefficient blocks side by side, each column scaled to unit norm (the M-norm of
+/// the projected function), so that no descriptor dominates by its scale.
+fn normalised_columns(blocks: &[Mat<f64>]) -> Mat<f64> {
+    let k = blocks.first().map_or(0, |b| b.nrows());
+    let columns: Vec<faer::ColRef<'_, f64>> = blocks
+        .iter()
+        .flat_map(|b| (0..b.ncols()).map(move |j| b.col(j)))
+        .collect();
+    Mat::from_fn(k, columns.len(), |i, j| {
+        let norm = columns[j].norm_l2();
+        if norm > 0.0 {
+            columns[j][i] / norm
+        } else {
+            0.0
+        }
+    })
+}
+
+/// A smooth colour field for looking at maps: each vertex's coordinates normalised to the
+/// bounding box, as RGB.
+pub fn coordinate_colors(vertices: &[[f64; 3]]) -> Vec<[u8; 3]> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in vertices {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    vertices
+        .iter()
+        .map(|p| {
+            std::array::from_fn(|k| {
+                let span = (hi[k] - lo[k]).max(f64::MIN_POSITIVE);
+                (((p[k] - lo[k]) / span).clamp(0.0, 1.0) * 255.0).round() as u8
+            })
+        })
+        .collect()
+}
