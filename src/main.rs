@@ -250,6 +250,9 @@ struct PointwiseArgs {
     /// Leave out the region distance functions.
     #[arg(long)]
     no_region_distances: bool,
+    /// Keep a mirror-image (orientation-reversing) answer as it is.
+    #[arg(long)]
+    no_orientation: bool,
 }
 
 impl PointwiseArgs {
@@ -304,6 +307,9 @@ impl PointwiseArgs {
         }
         if self.no_region_distances {
             p.region_distances = false;
+        }
+        if self.no_orientation {
+            p.orientation = false;
         }
         p.validate()?;
         Ok(p)

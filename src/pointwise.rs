@@ -67,6 +67,10 @@ pub struct PointwiseParams {
     pub laplacian_weight: f64,
     /// Refinement of the first map.
     pub refinement: Refinement,
+    /// For consistently oriented meshes, keep the orientation: when the one-to-one regions
+    /// give an orientation-reversing map (a mirror-image answer), use the other choice of
+    /// every two-way symmetric group if that keeps the orientation better.
+    pub orientation: bool,
 }
 
 impl Default for PointwiseParams {
@@ -82,6 +86,7 @@ impl Default for PointwiseParams {
             descriptor_step: 5,
             laplacian_weight: 1.0,
             refinement: Refinement::ZoomOut(ZoomOutParams::default()),
+            orientation: true,
         }
     }
 }
@@ -181,85 +186,59 @@ impl PointwiseMap {
         params.validate()?;
         let started = Instant::now();
         let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
-        let (mut coef_a, mut coef_b) = (Vec::new(), Vec::new());
-        if params.regions != RegionConstraints::None {
-            let regions = regions.ok_or(Error::InvalidParameter {
-                name: "regions",
-                reason: "region constraints need a region correspondence".into(),
-            })?;
-            let (fa, fb) = region_indicators(regions, params.regions);
-            if fa.ncols() == 0 {
-                return Err(Error::InvalidParameter {
+        let groups = match params.regions {
+            RegionConstraints::None => Vec::new(),
+            kind => {
+                let regions = regions.ok_or(Error::InvalidParameter {
                     name: "regions",
-                    reason: "the region correspondence has no match to constrain the map".into(),
-                });
+                    reason: "region constraints need a region correspondence".into(),
+                })?;
+                let groups = region_groups(regions, kind);
+                if groups.is_empty() {
+                    return Err(Error::InvalidParameter {
+                        name: "regions",
+                        reason: "the region correspondence has no match to constrain the map"
+                            .into(),
+                    });
+                }
+                groups
             }
-            for &t in &params.region_times {
-                coef_a.push(diffused(basis_a, k, fa.as_ref(), t));
-                coef_b.push(diffused(basis_b, k, fb.as_ref(), t));
-            }
-            if params.region_distances {
-                let da = distance_functions(a, basis_a, fa.as_ref());
-                let db = distance_functions(b, basis_b, fb.as_ref());
-                coef_a.push(project(
-                    basis_a.vectors.as_ref(),
-                    &basis_a.mass,
-                    k,
-                    da.as_ref(),
-                ));
-                coef_b.push(project(
-                    basis_b.vectors.as_ref(),
-                    &basis_b.mass,
-                    k,
-                    db.as_ref(),
-                ));
+        };
+        let solve = |groups: &[(Vec<u32>, Vec<u32>)]| -> Result<Mat<f64>> {
+            let (coef_a, coef_b) =
+                descriptor_coefficients(a, basis_a, b, basis_b, regions, groups, params, k)?;
+            solve_fmap(
+                coef_a.as_ref(),
+                coef_b.as_ref(),
+                &basis_a.values,
+                &basis_b.values,
+                params.laplacian_weight,
+            )
+        };
+        let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+        let mut fmap = solve(&groups)?;
+        let mut p2p = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b);
+        // A one-to-one region answer may be the mirror image of the truth (paper, section
+        // 5.2). Where both shapes are consistently oriented meshes, the map that keeps the
+        // orientation is the better one: try the other choice of every two-way group.
+        if params.orientation && params.regions == RegionConstraints::OneToOne {
+            if let (Some(regions), Some(score)) = (regions, orientation_score(a, b, &p2p)) {
+                let mirrored = (score < ORIENTATION_KEPT)
+                    .then(|| mirrored_groups(a, basis_a, b, basis_b, regions))
+                    .filter(|m| *m != groups);
+                if let Some(mirrored) = mirrored {
+                    let other = solve(&mirrored)?;
+                    let other_p2p = fmap_to_p2p(other.as_ref(), phi_a, phi_b);
+                    if orientation_score(a, b, &other_p2p).is_some_and(|s| s > score) {
+                        (fmap, p2p) = (other, other_p2p);
+                    }
+                }
             }
         }
-        if let Some(wks_params) = &params.wks {
-            coef_a.push(project_every(
-                basis_a,
-                k,
-                &wks(basis_a, wks_params)?,
-                params.descriptor_step,
-            ));
-            coef_b.push(project_every(
-                basis_b,
-                k,
-                &wks(basis_b, wks_params)?,
-                params.descriptor_step,
-            ));
-        }
-        if let Some(hks_params) = &params.hks {
-            coef_a.push(project_every(
-                basis_a,
-                k,
-                &hks(basis_a, hks_params)?,
-                params.descriptor_step,
-            ));
-            coef_b.push(project_every(
-                basis_b,
-                k,
-                &hks(basis_b, hks_params)?,
-                params.descriptor_step,
-            ));
-        }
-        let coef_a = normalised_columns(&coef_a);
-        let coef_b = normalised_columns(&coef_b);
-        let fmap = solve_fmap(
-            coef_a.as_ref(),
-            coef_b.as_ref(),
-            &basis_a.values,
-            &basis_b.values,
-            params.laplacian_weight,
-        )?;
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
         let (fmap_ab, p2p_ba) = match &params.refinement {
-            Refinement::None => {
-                let p2p = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b);
-                (fmap, p2p)
-            }
+            Refinement::None => (fmap, p2p),
             Refinement::ZoomOut(z) => {
                 let z = ZoomOutParams {
                     k_end: z.k_end.min(basis_a.len()).min(basis_b.len()),
@@ -287,6 +266,274 @@ impl PointwiseMap {
             },
         })
     }
+}
+
+/// The spectral coefficients (first `k`) of every descriptor pair: the region groups'
+/// indicators (diffused) and distance functions, WKS, HKS; columns normalised.
+#[allow(clippy::too_many_arguments)]
+fn descriptor_coefficients(
+    a: &Shape,
+    basis_a: &Eigenbasis,
+    b: &Shape,
+    basis_b: &Eigenbasis,
+    regions: Option<&Correspondence>,
+    groups: &[(Vec<u32>, Vec<u32>)],
+    params: &PointwiseParams,
+    k: usize,
+) -> Result<(Mat<f64>, Mat<f64>)> {
+    let (mut coef_a, mut coef_b) = (Vec::new(), Vec::new());
+    if let (Some(regions), false) = (regions, groups.is_empty()) {
+        let fa = indicators(regions.regions_a(), regions.graph_a.n_nodes(), groups, true);
+        let fb = indicators(
+            regions.regions_b(),
+            regions.graph_b.n_nodes(),
+            groups,
+            false,
+        );
+        for &t in &params.region_times {
+            coef_a.push(diffused(basis_a, k, fa.as_ref(), t));
+            coef_b.push(diffused(basis_b, k, fb.as_ref(), t));
+        }
+        if params.region_distances {
+            let da = distance_functions(a, basis_a, fa.as_ref());
+            let db = distance_functions(b, basis_b, fb.as_ref());
+            coef_a.push(project(
+                basis_a.vectors.as_ref(),
+                &basis_a.mass,
+                k,
+                da.as_ref(),
+            ));
+            coef_b.push(project(
+                basis_b.vectors.as_ref(),
+                &basis_b.mass,
+                k,
+                db.as_ref(),
+            ));
+        }
+    }
+    for (on, descriptor_a, descriptor_b) in [
+        (
+            params.wks.is_some(),
+            params.wks.as_ref().map(|w| wks(basis_a, w)),
+            params.wks.as_ref().map(|w| wks(basis_b, w)),
+        ),
+        (
+            params.hks.is_some(),
+            params.hks.as_ref().map(|h| hks(basis_a, h)),
+            params.hks.as_ref().map(|h| hks(basis_b, h)),
+        ),
+    ] {
+        if let (true, Some(da), Some(db)) = (on, descriptor_a, descriptor_b) {
+            coef_a.push(project_every(basis_a, k, &da?, params.descriptor_step));
+            coef_b.push(project_every(basis_b, k, &db?, params.descriptor_step));
+        }
+    }
+    Ok((normalised_columns(&coef_a), normalised_columns(&coef_b)))
+}
+
+/// Fraction of B's triangles whose image under `p2p_ba` keeps its orientation on A
+/// (the mapped triangle's normal agrees with A's vertex normals there); `None` when either
+/// shape is a point cloud or has inconsistently oriented faces, or no triangle maps to a
+/// proper triangle.
+pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
+    let oriented = |s: &Shape| {
+        s.kind() == crate::shape::ShapeKind::Mesh
+            && !s
+                .warnings()
+                .iter()
+                .any(|w| matches!(w, crate::shape::Warning::InconsistentOrientation { .. }))
+    };
+    if !oriented(a) || !oriented(b) {
+        return None;
+    }
+    let va = a.vertices();
+    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let cross = |u: [f64; 3], v: [f64; 3]| {
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    let mut normals = vec![[0.0; 3]; va.len()];
+    for t in a.triangles() {
+        let n = cross(
+            sub(va[t[1] as usize], va[t[0] as usize]),
+            sub(va[t[2] as usize], va[t[0] as usize]),
+        );
+        for &v in t {
+            for c in 0..3 {
+                normals[v as usize][c] += n[c];
+            }
+        }
+    }
+    let (mut kept, mut total) = (0usize, 0usize);
+    for t in b.triangles() {
+        let m = t.map(|v| p2p_ba[v as usize] as usize);
+        if m[0] == m[1] || m[1] == m[2] || m[0] == m[2] {
+            continue;
+        }
+        let n = cross(sub(va[m[1]], va[m[0]]), sub(va[m[2]], va[m[0]]));
+        let reference: f64 = (0..3)
+            .map(|c| n[c] * (normals[m[0]][c] + normals[m[1]][c] + normals[m[2]][c]))
+            .sum();
+        total += 1;
+        if reference > 0.0 {
+            kept += 1;
+        }
+    }
+    (total > 0).then(|| kept as f64 / total as f64)
+}
+
+/// Below this fraction of triangles keeping their orientation, a map counts as a mirror
+/// image (the fraction is about 0.75 for a good map and 0.3-0.47 for a mirrored one on
+/// FAUST; 0.5 is the midpoint of a coin toss).
+const ORIENTATION_KEPT: f64 = 0.5;
+
+/// Largest number of alternative matchings enumerated for one symmetric group when
+/// looking for the mirror-image answer (a 4x4 group of two left/right pairs has 9).
+const MIRROR_OPTIONS_CAP: usize = 5040;
+
+/// The mirror image of the one-to-one answer: in every symmetric group with a choice, a
+/// matching of the same size that shares no pair with the current one (for a left/right
+/// pair: the swap), the groups chosen together to minimise the distortion of region
+/// distances ([`crate::symmetry::distortion_energy`]) by a few sweeps of coordinate
+/// descent. Returned as one-to-one groups; equal to `groups` when no group has a choice.
+fn mirrored_groups(
+    a: &Shape,
+    basis_a: &Eigenbasis,
+    b: &Shape,
+    basis_b: &Eigenbasis,
+    regions: &Correspondence,
+) -> Vec<(Vec<u32>, Vec<u32>)> {
+    let current = &regions.matches_one_to_one;
+    let allowed = |x: u32, y: u32| {
+        regions.matches.binary_search(&(x, y)).is_ok() || regions.matches.contains(&(x, y))
+    };
+    let mut fixed: Vec<(u32, u32)> = Vec::new();
+    let mut choices: Vec<Vec<Vec<(u32, u32)>>> = Vec::new();
+    for (ra, rb) in crate::symmetry::bipartite_groups(&regions.matches) {
+        let mine: Vec<(u32, u32)> = current
+            .iter()
+            .copied()
+            .filter(|p| ra.contains(&p.0))
+            .collect();
+        let options = if ra.len() <= rb.len() {
+            alternative_matchings(&ra, &rb, &|x, y| allowed(x, y) && !mine.contains(&(x, y)))
+        } else {
+            alternative_matchings(&rb, &ra, &|y, x| allowed(x, y) && !mine.contains(&(x, y)))
+                .into_iter()
+                .map(|m| m.into_iter().map(|(y, x)| (x, y)).collect())
+                .collect()
+        };
+        let full: Vec<Vec<(u32, u32)>> = options
+            .into_iter()
+            .filter(|m: &Vec<(u32, u32)>| m.len() == mine.len())
+            .collect();
+        if ra.len() + rb.len() <= 2 || full.is_empty() || full.len() > MIRROR_OPTIONS_CAP {
+            fixed.extend(mine);
+        } else {
+            choices.push(full);
+        }
+    }
+    if choices.is_empty() {
+        return current.iter().map(|&(i, j)| (vec![i], vec![j])).collect();
+    }
+    let d_a = crate::geodesic::region_distance_matrix(
+        a,
+        &basis_a.mass,
+        regions.regions_a(),
+        regions.graph_a.n_nodes(),
+        1.0 / basis_a.input_area.sqrt(),
+    );
+    let d_b = crate::geodesic::region_distance_matrix(
+        b,
+        &basis_b.mass,
+        regions.regions_b(),
+        regions.graph_b.n_nodes(),
+        1.0 / basis_b.input_area.sqrt(),
+    );
+    let assemble = |pick: &[usize]| {
+        let mut pairs = fixed.clone();
+        for (g, &o) in pick.iter().enumerate() {
+            pairs.extend(&choices[g][o]);
+        }
+        pairs
+    };
+    let energy = |pick: &[usize]| {
+        crate::symmetry::distortion_energy(&assemble(pick), d_a.as_ref(), d_b.as_ref())
+    };
+    let mut pick = vec![0usize; choices.len()];
+    for _sweep in 0..4 {
+        let mut changed = false;
+        for g in 0..choices.len() {
+            let mut best = (energy(&pick), pick[g]);
+            for o in 0..choices[g].len() {
+                let mut trial = pick.clone();
+                trial[g] = o;
+                let e = energy(&trial);
+                if e < best.0 - 1e-12 {
+                    best = (e, o);
+                }
+            }
+            if best.1 != pick[g] {
+                pick[g] = best.1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let mut pairs = assemble(&pick);
+    pairs.sort_unstable();
+    pairs.into_iter().map(|(i, j)| (vec![i], vec![j])).collect()
+}
+
+/// Every matching that gives each of `small` a distinct partner in `large` with
+/// `allowed(small, large)`, up to [`MIRROR_OPTIONS_CAP`] + 1 of them.
+fn alternative_matchings(
+    small: &[u32],
+    large: &[u32],
+    allowed: &dyn Fn(u32, u32) -> bool,
+) -> Vec<Vec<(u32, u32)>> {
+    fn extend(
+        i: usize,
+        small: &[u32],
+        large: &[u32],
+        allowed: &dyn Fn(u32, u32) -> bool,
+        used: &mut Vec<bool>,
+        partial: &mut Vec<(u32, u32)>,
+        out: &mut Vec<Vec<(u32, u32)>>,
+    ) {
+        if out.len() > MIRROR_OPTIONS_CAP {
+            return;
+        }
+        if i == small.len() {
+            out.push(partial.clone());
+            return;
+        }
+        for (j, &y) in large.iter().enumerate() {
+            if !used[j] && allowed(small[i], y) {
+                used[j] = true;
+                partial.push((small[i], y));
+                extend(i + 1, small, large, allowed, used, partial, out);
+                partial.pop();
+                used[j] = false;
+            }
+        }
+    }
+    let mut out = Vec::new();
+    extend(
+        0,
+        small,
+        large,
+        allowed,
+        &mut vec![false; large.len()],
+        &mut Vec::new(),
+        &mut out,
+    );
+    out
 }
 
 /// Everything from two shapes: eigenbases, region correspondence, pointwise map.
@@ -356,62 +603,44 @@ pub fn truncated(basis: &Eigenbasis, k: usize) -> Eigenbasis {
     }
 }
 
-/// Indicator functions (columns) of corresponding region sets on A and B.
-pub fn region_indicators(
+/// The corresponding region sets that constrain the map: one pair per one-to-one match,
+/// or one per group of symmetric matches (the connected components of their bipartite
+/// graph, [`crate::symmetry::bipartite_groups`]).
+pub fn region_groups(
     regions: &Correspondence,
     kind: RegionConstraints,
-) -> (Mat<f64>, Mat<f64>) {
-    let groups: Vec<(Vec<u32>, Vec<u32>)> = match kind {
+) -> Vec<(Vec<u32>, Vec<u32>)> {
+    match kind {
         RegionConstraints::None => Vec::new(),
         RegionConstraints::OneToOne => regions
             .matches_one_to_one
             .iter()
             .map(|&(i, j)| (vec![i], vec![j]))
             .collect(),
-        RegionConstraints::Symmetric => match_groups(&regions.matches),
-    };
-    let indicator = |labels: &[u32], n_regions: usize, a_side: bool| {
-        let mut member = vec![vec![false; n_regions]; groups.len()];
-        for (m, group) in member.iter_mut().zip(&groups) {
-            for &r in if a_side { &group.0 } else { &group.1 } {
-                m[r as usize] = true;
-            }
-        }
-        Mat::from_fn(labels.len(), groups.len(), |v, g| {
-            if member[g][labels[v] as usize] {
-                1.0
-            } else {
-                0.0
-            }
-        })
-    };
-    let fa = indicator(regions.regions_a(), regions.graph_a.n_nodes(), true);
-    let fb = indicator(regions.regions_b(), regions.graph_b.n_nodes(), false);
-    (fa, fb)
+        RegionConstraints::Symmetric => crate::symmetry::bipartite_groups(&regions.matches),
+    }
 }
 
-/// Connected components of the bipartite graph of symmetric matches, as (regions of A,
-/// regions of B), ordered by their smallest region of A.
-pub fn match_groups(matches: &[(u32, u32)]) -> Vec<(Vec<u32>, Vec<u32>)> {
-    let mut groups: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
-    for &(i, j) in matches {
-        let hits: Vec<usize> = (0..groups.len())
-            .filter(|&g| groups[g].0.contains(&i) || groups[g].1.contains(&j))
-            .collect();
-        let mut merged = (vec![i], vec![j]);
-        for &g in hits.iter().rev() {
-            let (a, b) = groups.remove(g);
-            merged.0.extend(a);
-            merged.1.extend(b);
+/// Indicator functions (one column per group) of the groups' regions on A (`a_side`) or B.
+fn indicators(
+    labels: &[u32],
+    n_regions: usize,
+    groups: &[(Vec<u32>, Vec<u32>)],
+    a_side: bool,
+) -> Mat<f64> {
+    let mut member = vec![vec![false; n_regions]; groups.len()];
+    for (m, group) in member.iter_mut().zip(groups) {
+        for &r in if a_side { &group.0 } else { &group.1 } {
+            m[r as usize] = true;
         }
-        merged.0.sort_unstable();
-        merged.0.dedup();
-        merged.1.sort_unstable();
-        merged.1.dedup();
-        groups.push(merged);
     }
-    groups.sort();
-    groups
+    Mat::from_fn(labels.len(), groups.len(), |v, g| {
+        if member[g][labels[v] as usize] {
+            1.0
+        } else {
+            0.0
+        }
+    })
 }
 
 /// For every indicator column, the edge-graph distance from the vertices where it is 1

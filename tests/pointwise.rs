@@ -11,8 +11,7 @@ use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
 use shapecorr::fmap::{fmap_to_p2p, nearest_rows, p2p_to_fmap, zoomout, ZoomOutParams};
 use shapecorr::geodesic::HeatGeodesics;
 use shapecorr::pointwise::{
-    match_groups, PointwiseCorrespondence, PointwiseMap, PointwiseParams, Refinement,
-    RegionConstraints,
+    PointwiseCorrespondence, PointwiseMap, PointwiseParams, Refinement, RegionConstraints,
 };
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
 use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, Stage};
@@ -311,19 +310,6 @@ fn the_map_does_not_depend_on_the_thread_count() {
 }
 
 #[test]
-fn symmetric_match_groups_are_connected_components() {
-    let groups = match_groups(&[(0, 1), (1, 0), (1, 1), (2, 3), (4, 2), (0, 0)]);
-    assert_eq!(
-        groups,
-        vec![
-            (vec![0, 1], vec![0, 1]),
-            (vec![2], vec![3]),
-            (vec![4], vec![2])
-        ]
-    );
-}
-
-#[test]
 fn bad_parameters_and_missing_regions_are_clear_errors() {
     let mesh = humanoid(0, 800);
     let a = Shape::mesh(mesh.vertices, &mesh.triangles).unwrap();
@@ -398,4 +384,21 @@ fn cancelling_at_the_pointwise_stage_stops_the_call() {
     )
     .unwrap_err();
     assert!(matches!(err, Error::Cancelled), "{err}");
+}
+
+#[test]
+fn orientation_score_tells_a_map_from_its_mirror_image() {
+    let rest = humanoid(0, 3000);
+    let posed = humanoid(2, 3000);
+    let a = Shape::mesh(rest.vertices.clone(), &rest.triangles).unwrap();
+    let b = Shape::mesh(posed.vertices.clone(), &posed.triangles).unwrap();
+    let identity: Vec<u32> = (0..b.n_vertices() as u32).collect();
+    let mirror = synth::mirror_map(&rest);
+    let kept = shapecorr::pointwise::orientation_score(&a, &b, &identity).unwrap();
+    let mirrored = shapecorr::pointwise::orientation_score(&a, &b, &mirror).unwrap();
+    println!("orientation kept: identity {kept:.3}, mirror {mirrored:.3}");
+    assert!(kept > 0.95 && mirrored < 0.05, "{kept} {mirrored}");
+    // A point cloud has no orientation.
+    let cloud = Shape::point_cloud(posed.vertices).unwrap();
+    assert_eq!(shapecorr::pointwise::orientation_score(&a, &cloud, &identity), None);
 }
