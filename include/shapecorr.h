@@ -49,6 +49,9 @@
 // Symmetry breaking into a one-to-one region correspondence.
 #define SC_STAGE_SYMMETRY_BREAKING 6
 
+// The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
+#define SC_STAGE_POINTWISE_MAP 7
+
 // Side A: the first shape given to `sc_match`.
 #define SC_SIDE_A 0
 
@@ -71,6 +74,24 @@
 
 // A boolean option (`sc_params_set_bool`).
 #define SC_OPTION_BOOL 2
+
+// Option `p2p_regions`: no region constraint (then `p2p_wks` must be true).
+#define SC_P2P_REGIONS_NONE 0
+
+// Option `p2p_regions`: one constraint per one-to-one region match (the default).
+#define SC_P2P_REGIONS_ONE_TO_ONE 1
+
+// Option `p2p_regions`: one constraint per group of symmetric region matches.
+#define SC_P2P_REGIONS_SYMMETRIC 2
+
+// Option `p2p_refinement`: the first functional map's vertex map, unrefined.
+#define SC_P2P_REFINEMENT_NONE 0
+
+// Option `p2p_refinement`: ZoomOut (the default).
+#define SC_P2P_REFINEMENT_ZOOMOUT 1
+
+// Option `p2p_refinement`: spectral ICP.
+#define SC_P2P_REFINEMENT_ICP 2
 
 // Status of every fallible call. The numbers never change meaning; new codes are added.
 enum sc_status
@@ -123,10 +144,16 @@ typedef uint32_t sc_status;
 // once. Free it with `sc_correspondence_free`.
 typedef struct sc_correspondence sc_correspondence;
 
-// Every parameter of the method. Setters change it; use one handle from one thread while
-// setting, after which it may be shared for reading by concurrent `sc_match` calls.
-// Free it with `sc_params_free`.
+// Every parameter of the method: the region correspondence's and (options named `p2p_*`)
+// the pointwise map's. Setters change it; use one handle from one thread while setting,
+// after which it may be shared for reading by concurrent `sc_match`, `sc_symmetry_detect`
+// and `sc_pointwise_map` calls. Free it with `sc_params_free`.
 typedef struct sc_params sc_params;
+
+// The result of `sc_pointwise_map`: a vertex map from B to A, the functional map from A to
+// B and the region correspondence it was built on. Immutable: one handle may be read from
+// several threads at once. Free it with `sc_pointwise_free`.
+typedef struct sc_pointwise sc_pointwise;
 
 // A shape: a triangle mesh or a point cloud, validated. Immutable after creation: one
 // handle may be used from several threads at once (e.g. in concurrent `sc_match` calls).
@@ -319,8 +346,10 @@ void sc_params_free(sc_params *params);
 
 // Sets an integer option by name (see `sc_option_name`). Errors:
 // `SC_STATUS_UNKNOWN_OPTION`, `SC_STATUS_INVALID_ARGUMENT` (the option is not an
-// integer), `SC_STATUS_INVALID_PARAMETER` (negative). Ranges that involve several options
-// (k_min <= k_max) are checked when the parameters are used.
+// integer), `SC_STATUS_INVALID_PARAMETER` (negative, or a choice such as `p2p_regions`
+// out of its list). Ranges that involve several options (k_min <= k_max,
+// p2p_fmap_size <= p2p_eigenpairs) are checked when the parameters are used. Options named
+// `p2p_*` only affect `sc_pointwise_map`.
 //
 // # Safety
 // `params` must be live parameters; `name` a NUL-terminated string.
@@ -370,6 +399,92 @@ const char *sc_option_doc(size_t index);
 // Type of option `index`: `SC_OPTION_INT`, `SC_OPTION_DOUBLE` or `SC_OPTION_BOOL`;
 // `UINT32_MAX` past the end.
 uint32_t sc_option_type(size_t index);
+
+// Point-to-point map from shape `b` to shape `a` (meshes, point clouds or one of each):
+// the region correspondence of `sc_match`, then a functional map constrained by the matched
+// regions (options `p2p_*`), converted to a vertex map and refined. Each shape's eigenbasis
+// is computed once for both steps. Arguments as `sc_match`: `params` may be NULL for the
+// defaults, `progress` may be NULL; the progress stages are `sc_match`'s followed by
+// `SC_STAGE_POINTWISE_MAP`. The result is deterministic for given shapes and parameters,
+// whatever the number of threads.
+//
+// Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work, e.g. `p2p_fmap_size`
+// above `p2p_eigenpairs`, or no region constraint and no descriptor),
+// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+//
+// # Safety
+// `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,
+// `progress` NULL or a function safe to call with `userdata`; `out_pointwise` writable.
+sc_status sc_pointwise_map(const sc_shape *a,
+                           const sc_shape *b,
+                           const sc_params *params,
+                           sc_progress_callback progress,
+                           void *userdata,
+                           sc_pointwise **out_pointwise);
+
+// Frees a pointwise map; NULL is a no-op.
+//
+// # Safety
+// `pointwise` must be NULL or live, not used afterwards.
+void sc_pointwise_free(sc_pointwise *pointwise);
+
+// Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`, as given to
+// `sc_pointwise_map`); 0 for NULL or a bad side. The map has `SC_SIDE_B`'s count of
+// values, each below `SC_SIDE_A`'s count.
+//
+// # Safety
+// `pointwise` must be NULL or live.
+size_t sc_pointwise_n_vertices(const sc_pointwise *pointwise, uint32_t side);
+
+// Copies the map from B to A: for every vertex `v` of B, in the caller's vertex order, the
+// vertex of A it corresponds to (`sc_pointwise_n_vertices(p, SC_SIDE_B)` values, each below
+// `sc_pointwise_n_vertices(p, SC_SIDE_A)`) into `out_map` of `len` elements.
+//
+// # Safety
+// `pointwise` must be live; `out_map` must point to `len` writable elements.
+sc_status sc_pointwise_map_b_to_a(const sc_pointwise *pointwise, uint32_t *out_map, size_t len);
+
+// Rows of the functional map from A to B: the number of B's basis functions (0 for NULL).
+//
+// # Safety
+// `pointwise` must be NULL or live.
+size_t sc_pointwise_fmap_rows(const sc_pointwise *pointwise);
+
+// Columns of the functional map from A to B: the number of A's basis functions (0 for
+// NULL).
+//
+// # Safety
+// `pointwise` must be NULL or live.
+size_t sc_pointwise_fmap_cols(const sc_pointwise *pointwise);
+
+// Copies the final functional map from A to B, row by row (`rows * cols` values, see
+// `sc_pointwise_fmap_rows` and `_cols`), into `out_fmap` of `len` elements: it maps the
+// spectral coefficients of a function on A (in A's Laplacian eigenbasis) to those of the
+// transported function on B.
+//
+// # Safety
+// `pointwise` must be live; `out_fmap` must point to `len` writable elements.
+sc_status sc_pointwise_fmap(const sc_pointwise *pointwise, double *out_fmap, size_t len);
+
+// The region correspondence the map was built on, as a new `sc_correspondence` (a copy the
+// caller frees with `sc_correspondence_free`, independent of `pointwise`). Its timings count
+// the region stages only: the eigenbases' are `sc_pointwise_seconds`'.
+//
+// # Safety
+// `pointwise` must be live; `out_correspondence` writable.
+sc_status sc_pointwise_regions(const sc_pointwise *pointwise,
+                               sc_correspondence **out_correspondence);
+
+// Seconds spent in a stage of the call: `stage` is one of `"eigenbasis_a"`,
+// `"eigenbasis_b"`, `"regions"` (the region correspondence after the eigenbases), `"fmap"`
+// (descriptors and the first functional map), `"refinement"` (the vertex map and its
+// refinement), `"total"`.
+//
+// # Safety
+// `pointwise` must be live; `stage` a NUL-terminated string; `out_seconds` writable.
+sc_status sc_pointwise_seconds(const sc_pointwise *pointwise,
+                               const char *stage,
+                               double *out_seconds);
 
 // A triangle mesh from `n_vertices` points `xyz = x0 y0 z0 x1 y1 z1 ...` (doubles, packed,
 // 3 per vertex) and `n_triangles` triangles `triangles = a0 b0 c0 a1 ...` (0-based vertex

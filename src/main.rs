@@ -277,7 +277,7 @@ impl PointwiseArgs {
         }
         p.refinement = match self.refine.as_deref() {
             None | Some("zoomout") => Refinement::ZoomOut(zoom),
-            Some("icp") => Refinement::Icp(10),
+            Some("icp") => Refinement::Icp(shapecorr::options::ICP_ITERATIONS),
             Some("none") => Refinement::None,
             Some(other) => {
                 return Err(Error::InvalidParameter {

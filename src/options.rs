@@ -1,12 +1,19 @@
-//! Named options: the parameters of [`Params`] that the C API, the Python binding and the
-//! add-ons set by name (`"k_min"`, `"gap_ratio"`, ...). One table, so every front end offers
-//! the same options with the same defaults, which come from `Params::default()`.
+//! Named options: the parameters of [`Params`] (region correspondence) and of
+//! [`PointwiseParams`] (point-to-point map, names starting with `p2p_`) that the C API, the
+//! Python binding and the add-ons set by name (`"k_min"`, `"gap_ratio"`,
+//! `"p2p_fmap_size"`, ...). One table, so every front end offers the same options with the
+//! same defaults, which come from `Params::default()` and `PointwiseParams::default()`.
+//! [`Options`] holds a value for every option.
 //!
 //! A value is type-checked and range-checked here as far as the option alone allows
-//! (integers non-negative and within range, floats finite); the checks that involve several
-//! options (`k_min <= k_max`) are [`Params::validate`]'s.
+//! (integers non-negative and within range, choices among their listed values, floats
+//! finite); the checks that involve several options (`k_min <= k_max`,
+//! `p2p_fmap_size <= p2p_eigenpairs`) are [`Params::validate`]'s and
+//! [`PointwiseParams::validate`]'s.
 
 use crate::correspondence::Params;
+use crate::fmap::ZoomOutParams;
+use crate::pointwise::{PointwiseParams, Refinement, RegionConstraints};
 use crate::{Error, Result};
 
 /// The type of an option's value.
@@ -40,6 +47,16 @@ impl OptionValue {
     }
 }
 
+/// Which parameters an option belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OptionGroup {
+    /// The region correspondence ([`Params`]): used by every job.
+    Regions,
+    /// The point-to-point map ([`PointwiseParams`]): used only when a pointwise map is
+    /// computed. The names start with `p2p_`.
+    Pointwise,
+}
+
 /// One named option.
 #[derive(Debug, Clone, Copy)]
 pub struct OptionInfo {
@@ -47,6 +64,8 @@ pub struct OptionInfo {
     pub name: &'static str,
     /// The type of its value.
     pub option_type: OptionType,
+    /// The parameters it sets.
+    pub group: OptionGroup,
     /// One line: what it does.
     pub doc: &'static str,
 }
@@ -55,9 +74,38 @@ const fn info(name: &'static str, option_type: OptionType, doc: &'static str) ->
     OptionInfo {
         name,
         option_type,
+        group: OptionGroup::Regions,
         doc,
     }
 }
+
+const fn p2p(name: &'static str, option_type: OptionType, doc: &'static str) -> OptionInfo {
+    OptionInfo {
+        name,
+        option_type,
+        group: OptionGroup::Pointwise,
+        doc,
+    }
+}
+
+/// The choices of `p2p_regions`, by value (0, 1, 2).
+pub const P2P_REGIONS: [RegionConstraints; 3] = [
+    RegionConstraints::None,
+    RegionConstraints::OneToOne,
+    RegionConstraints::Symmetric,
+];
+
+/// `p2p_refinement = 0`: the first functional map's vertex map, unrefined.
+pub const P2P_REFINEMENT_NONE: i64 = 0;
+/// `p2p_refinement = 1`: ZoomOut (`p2p_zoomout_end`, `p2p_zoomout_step`,
+/// `p2p_zoomout_sample`).
+pub const P2P_REFINEMENT_ZOOMOUT: i64 = 1;
+/// `p2p_refinement = 2`: spectral ICP (`p2p_icp_iterations`).
+pub const P2P_REFINEMENT_ICP: i64 = 2;
+
+/// Iterations of spectral ICP when it is chosen by name (`p2p_refinement = 2`; the command
+/// line's `--refine icp` also runs 10).
+pub const ICP_ITERATIONS: usize = 10;
 
 use OptionType::{Bool, Float, Int};
 
@@ -138,6 +186,71 @@ pub const OPTIONS: &[OptionInfo] = &[
         Int,
         "one-to-one: local-search restarts above that limit",
     ),
+    info(
+        "hks_fallback",
+        Bool,
+        "second try with HKS from a smaller time when the first leaves area unmatched",
+    ),
+    p2p(
+        "p2p_eigenpairs",
+        Int,
+        "pointwise map: Laplacian eigenpairs per shape (the largest basis any step uses)",
+    ),
+    p2p(
+        "p2p_fmap_size",
+        Int,
+        "pointwise map: size k of the first functional map (k x k)",
+    ),
+    p2p(
+        "p2p_regions",
+        Int,
+        "pointwise map: region constraints: 0 none, 1 one-to-one matches, 2 symmetric groups",
+    ),
+    p2p(
+        "p2p_region_distances",
+        Bool,
+        "pointwise map: also constrain by the distance from each matched region",
+    ),
+    p2p(
+        "p2p_wks",
+        Bool,
+        "pointwise map: also constrain by wave kernel signatures (100 energies)",
+    ),
+    p2p(
+        "p2p_descriptor_step",
+        Int,
+        "pointwise map: keep every n-th WKS energy",
+    ),
+    p2p(
+        "p2p_laplacian_weight",
+        Float,
+        "pointwise map: weight of the Laplacian commutativity term",
+    ),
+    p2p(
+        "p2p_refinement",
+        Int,
+        "pointwise map: refinement: 0 none, 1 ZoomOut, 2 spectral ICP",
+    ),
+    p2p(
+        "p2p_zoomout_end",
+        Int,
+        "pointwise map: ZoomOut's final basis size (at most p2p_eigenpairs)",
+    ),
+    p2p(
+        "p2p_zoomout_step",
+        Int,
+        "pointwise map: eigenfunctions ZoomOut adds per iteration",
+    ),
+    p2p(
+        "p2p_zoomout_sample",
+        Int,
+        "pointwise map: vertices per shape ZoomOut iterates on (0: all)",
+    ),
+    p2p(
+        "p2p_icp_iterations",
+        Int,
+        "pointwise map: largest number of spectral ICP iterations",
+    ),
 ];
 
 /// The option called `name`.
@@ -180,15 +293,36 @@ fn to_finite(info: &OptionInfo, value: f64) -> Result<f64> {
     }
 }
 
+/// The option called `name`, of type `value` (if given) and of `group`.
+fn checked_info(
+    name: &str,
+    value: Option<OptionValue>,
+    group: OptionGroup,
+) -> Result<&'static OptionInfo> {
+    let info = option_info(name)?;
+    if info.group != group {
+        let holder = match info.group {
+            OptionGroup::Regions => "Params",
+            OptionGroup::Pointwise => "PointwiseParams",
+        };
+        return Err(Error::InvalidParameter {
+            name: info.name,
+            reason: format!("belongs to {holder}; set and read it through options::Options"),
+        });
+    }
+    match value {
+        Some(v) if v.option_type() != info.option_type => Err(wrong_type(info, v.option_type())),
+        _ => Ok(info),
+    }
+}
+
 impl Params {
-    /// Sets the option `name`. Errors with [`Error::UnknownOption`] for a name not in
-    /// [`OPTIONS`], and with [`Error::InvalidParameter`] for a value of the wrong type, a
-    /// negative integer or a non-finite float. Nothing changes on error.
+    /// Sets the option `name` (one of [`OptionGroup::Regions`]). Errors with
+    /// [`Error::UnknownOption`] for a name not in [`OPTIONS`], and with
+    /// [`Error::InvalidParameter`] for a pointwise option (see [`Options`]), a value of the
+    /// wrong type, a negative integer or a non-finite float. Nothing changes on error.
     pub fn set_option(&mut self, name: &str, value: OptionValue) -> Result<()> {
-        let info = option_info(name)?;
-        if value.option_type() != info.option_type {
-            return Err(wrong_type(info, value.option_type()));
-        }
+        let info = checked_info(name, Some(value), OptionGroup::Regions)?;
         match value {
             OptionValue::Int(v) => {
                 // Seeds take the full 64 bits (reinterpreted), so any integer is a seed.
@@ -238,9 +372,10 @@ impl Params {
         Ok(())
     }
 
-    /// The current value of the option `name` ([`Error::UnknownOption`] if there is none).
+    /// The current value of the option `name` ([`Error::UnknownOption`] if there is none,
+    /// [`Error::InvalidParameter`] for a pointwise option).
     pub fn option(&self, name: &str) -> Result<OptionValue> {
-        let info = option_info(name)?;
+        let info = checked_info(name, None, OptionGroup::Regions)?;
         let int = |v: usize| OptionValue::Int(v as i64);
         Ok(match info.name {
             "k_min" => int(self.segmentation.k_min),
@@ -268,32 +403,195 @@ impl Params {
     }
 }
 
+/// A value for every named option: the region correspondence's [`Params`] and the
+/// pointwise map's [`PointwiseParams`] (what the C API's `sc_params` handle holds).
+///
+/// The settings of each refinement are kept apart from the choice of refinement, so options
+/// may be set in any order: `p2p_zoomout_end` set while ICP is chosen is used once
+/// `p2p_refinement` chooses ZoomOut. That is why the pointwise parameters are read through
+/// [`Options::pointwise`] and changed only through [`Options::set_option`].
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The region correspondence's parameters.
+    pub params: Params,
+    /// The pointwise map's parameters; `pointwise.refinement` is always built from the
+    /// two fields below.
+    pointwise: PointwiseParams,
+    /// ZoomOut's settings, whichever refinement is chosen.
+    zoomout: ZoomOutParams,
+    /// Spectral ICP's iterations, whichever refinement is chosen.
+    icp_iterations: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options::new(Params::default(), PointwiseParams::default())
+    }
+}
+
+impl Options {
+    /// Options holding these parameters (the refinement's settings not in use take their
+    /// defaults).
+    pub fn new(params: Params, pointwise: PointwiseParams) -> Self {
+        let zoomout = match &pointwise.refinement {
+            Refinement::ZoomOut(z) => z.clone(),
+            _ => ZoomOutParams::default(),
+        };
+        let icp_iterations = match pointwise.refinement {
+            Refinement::Icp(n) => n,
+            _ => ICP_ITERATIONS,
+        };
+        Options {
+            params,
+            pointwise,
+            zoomout,
+            icp_iterations,
+        }
+    }
+
+    /// The pointwise map's parameters.
+    pub fn pointwise(&self) -> &PointwiseParams {
+        &self.pointwise
+    }
+
+    /// Checks both sets of parameters ([`Params::validate`], [`PointwiseParams::validate`]).
+    pub fn validate(&self) -> Result<()> {
+        self.params.validate()?;
+        self.pointwise.validate()
+    }
+
+    /// Sets any option: errors as [`Params::set_option`] (without the pointwise one), and
+    /// [`Error::InvalidParameter`] for a choice out of its list. Nothing changes on error.
+    pub fn set_option(&mut self, name: &str, value: OptionValue) -> Result<()> {
+        let info = option_info(name)?;
+        if info.group == OptionGroup::Regions {
+            return self.params.set_option(name, value);
+        }
+        let info = checked_info(name, Some(value), OptionGroup::Pointwise)?;
+        let p = &mut self.pointwise;
+        match value {
+            OptionValue::Int(v) => {
+                let choice = |n: usize| -> Result<usize> {
+                    usize::try_from(v).ok().filter(|&i| i < n).ok_or_else(|| {
+                        Error::InvalidParameter {
+                            name: info.name,
+                            reason: format!("must be one of 0 to {}, got {v}", n - 1),
+                        }
+                    })
+                };
+                match info.name {
+                    "p2p_regions" => p.regions = P2P_REGIONS[choice(P2P_REGIONS.len())?],
+                    "p2p_refinement" => {
+                        p.refinement = match choice(3)? as i64 {
+                            P2P_REFINEMENT_NONE => Refinement::None,
+                            P2P_REFINEMENT_ZOOMOUT => Refinement::ZoomOut(self.zoomout.clone()),
+                            _ => Refinement::Icp(self.icp_iterations),
+                        }
+                    }
+                    _ => {
+                        let v = to_usize(info, v)?;
+                        match info.name {
+                            "p2p_eigenpairs" => p.n_eigenpairs = v,
+                            "p2p_fmap_size" => p.fmap_size = v,
+                            "p2p_descriptor_step" => p.descriptor_step = v,
+                            "p2p_zoomout_end" => self.zoomout.k_end = v,
+                            "p2p_zoomout_step" => self.zoomout.step = v,
+                            "p2p_zoomout_sample" => self.zoomout.sample_size = v,
+                            "p2p_icp_iterations" => self.icp_iterations = v,
+                            other => unreachable!("integer option {other} has no field"),
+                        }
+                        // Keep the chosen refinement's settings current.
+                        match &mut p.refinement {
+                            Refinement::ZoomOut(z) => *z = self.zoomout.clone(),
+                            Refinement::Icp(n) => *n = self.icp_iterations,
+                            Refinement::None => {}
+                        }
+                    }
+                }
+            }
+            OptionValue::Float(v) => {
+                let v = to_finite(info, v)?;
+                match info.name {
+                    "p2p_laplacian_weight" => p.laplacian_weight = v,
+                    other => unreachable!("float option {other} has no field"),
+                }
+            }
+            OptionValue::Bool(v) => match info.name {
+                "p2p_region_distances" => p.region_distances = v,
+                "p2p_wks" => p.wks = v.then(|| p.wks.clone().unwrap_or_default()),
+                other => unreachable!("bool option {other} has no field"),
+            },
+        }
+        Ok(())
+    }
+
+    /// The current value of any option ([`Error::UnknownOption`] if there is none).
+    pub fn option(&self, name: &str) -> Result<OptionValue> {
+        let info = option_info(name)?;
+        if info.group == OptionGroup::Regions {
+            return self.params.option(name);
+        }
+        let p = &self.pointwise;
+        let int = |v: usize| OptionValue::Int(v as i64);
+        Ok(match info.name {
+            "p2p_eigenpairs" => int(p.n_eigenpairs),
+            "p2p_fmap_size" => int(p.fmap_size),
+            "p2p_regions" => int(P2P_REGIONS
+                .iter()
+                .position(|r| *r == p.regions)
+                .expect("every region constraint has a value")),
+            "p2p_region_distances" => OptionValue::Bool(p.region_distances),
+            "p2p_wks" => OptionValue::Bool(p.wks.is_some()),
+            "p2p_descriptor_step" => int(p.descriptor_step),
+            "p2p_laplacian_weight" => OptionValue::Float(p.laplacian_weight),
+            "p2p_refinement" => OptionValue::Int(match p.refinement {
+                Refinement::None => P2P_REFINEMENT_NONE,
+                Refinement::ZoomOut(_) => P2P_REFINEMENT_ZOOMOUT,
+                Refinement::Icp(_) => P2P_REFINEMENT_ICP,
+            }),
+            "p2p_zoomout_end" => int(self.zoomout.k_end),
+            "p2p_zoomout_step" => int(self.zoomout.step),
+            "p2p_zoomout_sample" => int(self.zoomout.sample_size),
+            "p2p_icp_iterations" => int(self.icp_iterations),
+            other => unreachable!("option {other} has no field"),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::descriptors::WksParams;
 
     #[test]
     fn every_option_reads_back_what_was_set() {
         for (i, info) in OPTIONS.iter().enumerate() {
-            let mut params = Params::default();
+            let mut options = Options::default();
             let value = match info.option_type {
+                // Choices take a valid value other than the default.
+                OptionType::Int if matches!(info.name, "p2p_regions" | "p2p_refinement") => {
+                    let OptionValue::Int(v) = options.option(info.name).unwrap() else {
+                        panic!("{} is not an integer", info.name)
+                    };
+                    OptionValue::Int((v + 1) % 3)
+                }
                 OptionType::Int => OptionValue::Int(3 + i as i64),
                 OptionType::Float => OptionValue::Float(0.125 + i as f64),
                 OptionType::Bool => {
-                    let OptionValue::Bool(b) = params.option(info.name).unwrap() else {
+                    let OptionValue::Bool(b) = options.option(info.name).unwrap() else {
                         panic!("{} is not a bool", info.name)
                     };
                     OptionValue::Bool(!b)
                 }
             };
-            assert_ne!(params.option(info.name).unwrap(), value, "{}", info.name);
-            params.set_option(info.name, value).unwrap();
-            assert_eq!(params.option(info.name).unwrap(), value, "{}", info.name);
+            assert_ne!(options.option(info.name).unwrap(), value, "{}", info.name);
+            options.set_option(info.name, value).unwrap();
+            assert_eq!(options.option(info.name).unwrap(), value, "{}", info.name);
             // Exactly this option changed: every other option still has its default.
-            let defaults = Params::default();
+            let defaults = Options::default();
             for other in OPTIONS.iter().filter(|o| o.name != info.name) {
                 assert_eq!(
-                    params.option(other.name).unwrap(),
+                    options.option(other.name).unwrap(),
                     defaults.option(other.name).unwrap(),
                     "setting {} changed {}",
                     info.name,
@@ -305,21 +603,38 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_types_match_the_defaults() {
-        let defaults = Params::default();
+        let defaults = Options::default();
         for (i, info) in OPTIONS.iter().enumerate() {
             assert!(OPTIONS[..i].iter().all(|o| o.name != info.name));
             assert_eq!(
                 defaults.option(info.name).unwrap().option_type(),
                 info.option_type
             );
+            assert_eq!(
+                info.name.starts_with("p2p_"),
+                info.group == OptionGroup::Pointwise,
+                "{}",
+                info.name
+            );
         }
     }
 
     #[test]
+    fn defaults_are_the_parameter_structs_defaults() {
+        let options = Options::default();
+        assert_eq!(options.pointwise(), &PointwiseParams::default());
+        assert!(options.validate().is_ok());
+        assert_eq!(
+            options.option("hks_fallback").unwrap(),
+            OptionValue::Bool(Params::default().fallback.is_some())
+        );
+    }
+
+    #[test]
     fn bad_names_types_and_values_are_rejected_without_change() {
-        let mut params = Params::default();
+        let mut options = Options::default();
         assert!(matches!(
-            params.set_option("k_mni", OptionValue::Int(3)),
+            options.set_option("k_mni", OptionValue::Int(3)),
             Err(Error::UnknownOption { .. })
         ));
         for (name, value) in [
@@ -328,17 +643,96 @@ mod tests {
             ("gap_ratio", OptionValue::Float(f64::NAN)),
             ("gap_ratio", OptionValue::Bool(true)),
             ("one_to_one", OptionValue::Int(1)),
+            ("p2p_regions", OptionValue::Int(3)),
+            ("p2p_regions", OptionValue::Int(-1)),
+            ("p2p_refinement", OptionValue::Int(3)),
+            ("p2p_fmap_size", OptionValue::Int(-2)),
+            ("p2p_fmap_size", OptionValue::Float(2.0)),
+            ("p2p_laplacian_weight", OptionValue::Float(f64::INFINITY)),
+            ("p2p_wks", OptionValue::Int(1)),
         ] {
-            let before = format!("{params:?}");
+            let before = format!("{options:?}");
             assert!(
                 matches!(
-                    params.set_option(name, value),
+                    options.set_option(name, value),
                     Err(Error::InvalidParameter { .. })
                 ),
                 "{name} = {value:?}"
             );
-            assert_eq!(format!("{params:?}"), before);
+            assert_eq!(format!("{options:?}"), before);
         }
+    }
+
+    #[test]
+    fn params_alone_refuse_pointwise_options() {
+        let mut params = Params::default();
+        let err = params
+            .set_option("p2p_fmap_size", OptionValue::Int(30))
+            .unwrap_err();
+        assert!(err.to_string().contains("Options"), "{err}");
+        assert!(params.option("p2p_fmap_size").is_err());
+        assert_eq!(params.option("k_min").unwrap(), OptionValue::Int(5));
+    }
+
+    #[test]
+    fn refinement_settings_survive_a_change_of_refinement_in_any_order() {
+        let mut options = Options::default();
+        let set = |o: &mut Options, name: &str, v: i64| o.set_option(name, OptionValue::Int(v));
+        set(&mut options, "p2p_refinement", P2P_REFINEMENT_ICP).unwrap();
+        set(&mut options, "p2p_zoomout_end", 60).unwrap();
+        set(&mut options, "p2p_icp_iterations", 4).unwrap();
+        assert_eq!(options.pointwise().refinement, Refinement::Icp(4));
+        set(&mut options, "p2p_refinement", P2P_REFINEMENT_ZOOMOUT).unwrap();
+        let expected = ZoomOutParams {
+            k_end: 60,
+            ..ZoomOutParams::default()
+        };
+        assert_eq!(
+            options.pointwise().refinement,
+            Refinement::ZoomOut(expected.clone())
+        );
+        set(&mut options, "p2p_zoomout_step", 2).unwrap();
+        assert_eq!(
+            options.pointwise().refinement,
+            Refinement::ZoomOut(ZoomOutParams {
+                step: 2,
+                ..expected
+            })
+        );
+        set(&mut options, "p2p_refinement", P2P_REFINEMENT_NONE).unwrap();
+        assert_eq!(options.pointwise().refinement, Refinement::None);
+        assert_eq!(
+            options.option("p2p_zoomout_end").unwrap(),
+            OptionValue::Int(60)
+        );
+        assert_eq!(
+            options.option("p2p_icp_iterations").unwrap(),
+            OptionValue::Int(4)
+        );
+        // Values valid alone but not together fail at use, not when set.
+        set(&mut options, "p2p_fmap_size", 200).unwrap();
+        assert!(matches!(
+            options.validate(),
+            Err(Error::InvalidParameter {
+                name: "pointwise.fmap_size",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn choices_map_to_the_pointwise_params() {
+        let mut options = Options::default();
+        for (v, kind) in P2P_REGIONS.iter().enumerate() {
+            options
+                .set_option("p2p_regions", OptionValue::Int(v as i64))
+                .unwrap();
+            assert_eq!(options.pointwise().regions, *kind);
+        }
+        options
+            .set_option("p2p_wks", OptionValue::Bool(true))
+            .unwrap();
+        assert_eq!(options.pointwise().wks, Some(WksParams::default()));
     }
 
     #[test]

@@ -407,9 +407,7 @@ fn mirrored_groups(
     regions: &Correspondence,
 ) -> Vec<(Vec<u32>, Vec<u32>)> {
     let current = &regions.matches_one_to_one;
-    let allowed = |x: u32, y: u32| {
-        regions.matches.binary_search(&(x, y)).is_ok() || regions.matches.contains(&(x, y))
-    };
+    let allowed = |x: u32, y: u32| regions.matches.binary_search(&(x, y)).is_ok();
     let mut fixed: Vec<(u32, u32)> = Vec::new();
     let mut choices: Vec<Vec<Vec<(u32, u32)>>> = Vec::new();
     for (ra, rb) in crate::symmetry::bipartite_groups(&regions.matches) {

@@ -400,5 +400,8 @@ fn orientation_score_tells_a_map_from_its_mirror_image() {
     assert!(kept > 0.95 && mirrored < 0.05, "{kept} {mirrored}");
     // A point cloud has no orientation.
     let cloud = Shape::point_cloud(posed.vertices).unwrap();
-    assert_eq!(shapecorr::pointwise::orientation_score(&a, &cloud, &identity), None);
+    assert_eq!(
+        shapecorr::pointwise::orientation_score(&a, &cloud, &identity),
+        None
+    );
 }

@@ -13,18 +13,22 @@
 //! - status codes are numbered once and never change meaning ([`ScStatus`]);
 //! - the detail of the last failure on a thread is [`sc_last_error`].
 //!
-//! Direction and naming: "side" A is the first shape given to `sc_match`, B the second;
-//! a match `(i, j)` pairs region `i` of A with region `j` of B.
+//! Direction and naming: "side" A is the first shape given to `sc_match` (or
+//! `sc_pointwise_map`), B the second; a match `(i, j)` pairs region `i` of A with region `j`
+//! of B; the pointwise map goes from B to A (a vertex of A for every vertex of B) and the
+//! functional map from A to B.
 
 mod boundary;
 mod correspondence;
 mod params;
+mod pointwise;
 mod shape;
 mod symmetry;
 
 pub use boundary::{sc_last_error, sc_status_str, ScStatus};
 pub use correspondence::*;
 pub use params::*;
+pub use pointwise::*;
 pub use shape::*;
 pub use symmetry::*;
 
@@ -52,6 +56,8 @@ pub const SC_STAGE_SEGMENTATION: u32 = 4;
 pub const SC_STAGE_MATCHING: u32 = 5;
 /// Symmetry breaking into a one-to-one region correspondence.
 pub const SC_STAGE_SYMMETRY_BREAKING: u32 = 6;
+/// The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
+pub const SC_STAGE_POINTWISE_MAP: u32 = 7;
 
 /// Progress callback: called on the calling thread with a stage (`SC_STAGE_*`) and the
 /// fraction of that stage done (0 to 1). Return `false` to cancel: the call then returns
@@ -98,8 +104,8 @@ struct CallbackProgress {
 impl crate::Progress for CallbackProgress {
     fn report(&mut self, stage: crate::Stage, fraction: f32) -> bool {
         match self.callback {
-            // SAFETY: the caller of sc_match/sc_symmetry_detect promised a valid callback
-            // for the duration of the call; it gets back its own userdata.
+            // SAFETY: the caller of sc_match/sc_symmetry_detect/sc_pointwise_map promised a
+            // valid callback for the duration of the call; it gets back its own userdata.
             Some(callback) => unsafe { callback(self.userdata, stage as u32, fraction) },
             None => true,
         }
@@ -129,6 +135,7 @@ mod tests {
         assert_eq!(SC_STAGE_SEGMENTATION, Stage::Segmentation as u32);
         assert_eq!(SC_STAGE_MATCHING, Stage::Matching as u32);
         assert_eq!(SC_STAGE_SYMMETRY_BREAKING, Stage::SymmetryBreaking as u32);
+        assert_eq!(SC_STAGE_POINTWISE_MAP, Stage::PointwiseMap as u32);
     }
 
     /// The handles' thread-safety promises in the header rest on these.
@@ -139,5 +146,6 @@ mod tests {
         check::<ScParams>();
         check::<ScCorrespondence>();
         check::<ScSymmetry>();
+        check::<ScPointwise>();
     }
 }

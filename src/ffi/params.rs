@@ -1,5 +1,6 @@
 //! Parameters: a handle holding every option, set and read by name. Defaults are
-//! `Params::default()`, the same as the command line's and the add-ons'.
+//! `Params::default()` and `PointwiseParams::default()`, the same as the command line's and
+//! the add-ons'.
 
 use std::ffi::{c_char, CString};
 use std::sync::OnceLock;
@@ -8,13 +9,14 @@ use super::boundary::{
     boundary, check_out, free_handle, give_handle, handle, input_str, Failure, FfiResult, ScStatus,
 };
 use crate::correspondence::Params;
-use crate::options::{option_info, OptionType, OptionValue, OPTIONS};
+use crate::options::{option_info, OptionType, OptionValue, Options, OPTIONS};
 
-/// Every parameter of the method. Setters change it; use one handle from one thread while
-/// setting, after which it may be shared for reading by concurrent `sc_match` calls.
-/// Free it with `sc_params_free`.
+/// Every parameter of the method: the region correspondence's and (options named `p2p_*`)
+/// the pointwise map's. Setters change it; use one handle from one thread while setting,
+/// after which it may be shared for reading by concurrent `sc_match`, `sc_symmetry_detect`
+/// and `sc_pointwise_map` calls. Free it with `sc_params_free`.
 pub struct ScParams {
-    pub(crate) params: Params,
+    pub(crate) options: Options,
 }
 
 /// An integer option (`sc_params_set_int`).
@@ -35,7 +37,7 @@ pub unsafe extern "C" fn sc_params_new(out_params: *mut *mut ScParams) -> ScStat
         give_handle(
             out_params,
             ScParams {
-                params: Params::default(),
+                options: Options::default(),
             },
         )
     })
@@ -62,7 +64,7 @@ unsafe fn set(params: *mut ScParams, name: *const c_char, value: OptionValue) ->
                 setter_suffix(info.option_type)
             )));
         }
-        Ok(params.params.set_option(name, value)?)
+        Ok(params.options.set_option(name, value)?)
     })
 }
 
@@ -81,7 +83,7 @@ unsafe fn get(
             setter_suffix(info.option_type)
         )));
     }
-    Ok(params.params.option(name)?)
+    Ok(params.options.option(name)?)
 }
 
 /// Reads option `name` of type `wanted` into `*out_value` (nothing written on error).
@@ -121,8 +123,10 @@ fn setter_suffix(t: OptionType) -> &'static str {
 
 /// Sets an integer option by name (see `sc_option_name`). Errors:
 /// `SC_STATUS_UNKNOWN_OPTION`, `SC_STATUS_INVALID_ARGUMENT` (the option is not an
-/// integer), `SC_STATUS_INVALID_PARAMETER` (negative). Ranges that involve several options
-/// (k_min <= k_max) are checked when the parameters are used.
+/// integer), `SC_STATUS_INVALID_PARAMETER` (negative, or a choice such as `p2p_regions`
+/// out of its list). Ranges that involve several options (k_min <= k_max,
+/// p2p_fmap_size <= p2p_eigenpairs) are checked when the parameters are used. Options named
+/// `p2p_*` only affect `sc_pointwise_map`.
 ///
 /// # Safety
 /// `params` must be live parameters; `name` a NUL-terminated string.
@@ -261,9 +265,16 @@ pub extern "C" fn sc_option_type(index: usize) -> u32 {
         })
 }
 
-/// The parameters behind a nullable handle: NULL means the defaults.
+/// The region parameters behind a nullable handle: NULL means the defaults.
 pub(crate) unsafe fn params_or_default(params: *const ScParams) -> Params {
     params
         .as_ref()
-        .map_or_else(Params::default, |p| p.params.clone())
+        .map_or_else(Params::default, |p| p.options.params.clone())
+}
+
+/// Every option behind a nullable handle: NULL means the defaults.
+pub(crate) unsafe fn options_or_default(params: *const ScParams) -> Options {
+    params
+        .as_ref()
+        .map_or_else(Options::default, |p| p.options.clone())
 }

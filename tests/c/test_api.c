@@ -1,6 +1,7 @@
 /*
  * C API tests: the whole life cycle on generated figures, every error path, cancellation,
- * concurrent calls on shared handles, and the version check. Compiled as C99 with
+ * concurrent calls on shared handles, the version check, and the point-to-point map (a
+ * permuted copy of a figure is mapped back to the identity). Compiled as C99 with
  * -Wall -Wextra -Wpedantic -Werror against include/shapecorr.h and linked against the
  * built libshapecorr.so by tests/c/run.sh (plain, under ASan+UBSan, and under valgrind).
  *
@@ -216,7 +217,7 @@ struct progress_log {
 static bool record_progress(void *userdata, uint32_t stage, float fraction) {
     struct progress_log *log = (struct progress_log *)userdata;
     log->calls++;
-    if (stage < SC_STAGE_LAPLACIAN || stage > SC_STAGE_SYMMETRY_BREAKING || !(fraction >= 0.0f) ||
+    if (stage < SC_STAGE_LAPLACIAN || stage > SC_STAGE_POINTWISE_MAP || !(fraction >= 0.0f) ||
         !(fraction <= 1.0f))
         log->bad++;
     log->last_stage = stage;
@@ -505,6 +506,289 @@ static void test_symmetry(void) {
     sc_shape_free(star);
 }
 
+/* ----------------------------------------------------------------- pointwise maps */
+
+/* Eigenpairs (and ZoomOut's final size) of the pointwise tests: the default, or in quick
+ * mode the region matching's own 50, so that valgrind does not wait on a larger basis. */
+static int64_t p2p_eigenpairs(void) { return quick ? 50 : 100; }
+
+static sc_params *pointwise_params(void) {
+    sc_params *params = NULL;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    if (quick) {
+        CHECK_STATUS(sc_params_set_int(params, "p2p_eigenpairs", p2p_eigenpairs()), SC_STATUS_OK);
+        CHECK_STATUS(sc_params_set_int(params, "p2p_fmap_size", 20), SC_STATUS_OK);
+        CHECK_STATUS(sc_params_set_int(params, "p2p_zoomout_end", p2p_eigenpairs()),
+                     SC_STATUS_OK);
+    }
+    return params;
+}
+
+static void test_pointwise_options(void) {
+    sc_params *params = NULL;
+    int64_t v = -1;
+    double w = -1.0;
+    bool flag = false;
+    size_t i, n_p2p = 0;
+    for (i = 0; i < sc_option_count(); i++)
+        n_p2p += strncmp(sc_option_name(i), "p2p_", 4) == 0;
+    CHECK(n_p2p >= 10, "%zu pointwise options", n_p2p);
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    /* Defaults are PointwiseParams::default()'s. */
+    CHECK_STATUS(sc_params_get_int(params, "p2p_eigenpairs", &v), SC_STATUS_OK);
+    CHECK(v == 100, "p2p_eigenpairs %lld", (long long)v);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_fmap_size", &v), SC_STATUS_OK);
+    CHECK(v == 40, "p2p_fmap_size %lld", (long long)v);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_regions", &v), SC_STATUS_OK);
+    CHECK(v == SC_P2P_REGIONS_ONE_TO_ONE, "p2p_regions %lld", (long long)v);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_refinement", &v), SC_STATUS_OK);
+    CHECK(v == SC_P2P_REFINEMENT_ZOOMOUT, "p2p_refinement %lld", (long long)v);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_zoomout_end", &v), SC_STATUS_OK);
+    CHECK(v == 100, "p2p_zoomout_end %lld", (long long)v);
+    CHECK_STATUS(sc_params_get_double(params, "p2p_laplacian_weight", &w), SC_STATUS_OK);
+    CHECK(w == 1.0, "p2p_laplacian_weight %g", w);
+    CHECK_STATUS(sc_params_get_bool(params, "p2p_region_distances", &flag), SC_STATUS_OK);
+    CHECK(flag, "region distances on by default");
+    CHECK_STATUS(sc_params_get_bool(params, "p2p_wks", &flag), SC_STATUS_OK);
+    CHECK(!flag, "WKS off by default");
+
+    /* Bad values: choices out of their list, wrong types, non-finite; nothing changes. */
+    CHECK_STATUS(sc_params_set_int(params, "p2p_regions", 3), SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "p2p_regions") != NULL, "message: %s", sc_last_error());
+    CHECK_STATUS(sc_params_set_int(params, "p2p_regions", -1), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_refinement", 7), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_fmap_size", -5), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_double(params, "p2p_fmap_size", 30.0),
+                 SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_params_set_double(params, "p2p_laplacian_weight", NAN),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_wks", 1), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_nonsense", 1), SC_STATUS_UNKNOWN_OPTION);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_regions", &v), SC_STATUS_OK);
+    CHECK(v == SC_P2P_REGIONS_ONE_TO_ONE, "unchanged by failed calls: %lld", (long long)v);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_fmap_size", &v), SC_STATUS_OK);
+    CHECK(v == 40, "unchanged by failed calls: %lld", (long long)v);
+
+    /* Settings of a refinement survive choosing another one (any order of setters). */
+    CHECK_STATUS(sc_params_set_int(params, "p2p_refinement", SC_P2P_REFINEMENT_ICP),
+                 SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_zoomout_end", 60), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_refinement", SC_P2P_REFINEMENT_ZOOMOUT),
+                 SC_STATUS_OK);
+    CHECK_STATUS(sc_params_get_int(params, "p2p_zoomout_end", &v), SC_STATUS_OK);
+    CHECK(v == 60, "p2p_zoomout_end kept: %lld", (long long)v);
+    sc_params_free(params);
+}
+
+/* Parameters checked by sc_pointwise_map before any work: each fails at once. */
+static void test_pointwise_errors(void) {
+    sc_shape *a = figure("star5", 0);
+    sc_params *params = NULL;
+    sc_pointwise *sentinel = (sc_pointwise *)(void *)&checks, *p = sentinel;
+    double t0;
+    struct {
+        const char *name;
+        int64_t value;
+    } bad[] = {
+        {"p2p_fmap_size", 120},   /* above p2p_eigenpairs (100) */
+        {"p2p_zoomout_end", 150}, /* above p2p_eigenpairs */
+        {"p2p_zoomout_step", 0},
+        {"p2p_regions", SC_P2P_REGIONS_NONE}, /* and no WKS: nothing constrains the map */
+        {"k_max", 3},                         /* below k_min */
+    };
+    size_t i;
+    CHECK_STATUS(sc_pointwise_map(NULL, a, NULL, NULL, NULL, &p), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_map(a, NULL, NULL, NULL, NULL, &p), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_map(a, a, NULL, NULL, NULL, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK(strstr(sc_last_error(), "out_pointwise") != NULL, "message: %s", sc_last_error());
+    for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+        CHECK_STATUS(sc_params_set_int(params, bad[i].name, bad[i].value), SC_STATUS_OK);
+        t0 = now_seconds();
+        CHECK_STATUS(sc_pointwise_map(a, a, params, NULL, NULL, &p), SC_STATUS_INVALID_PARAMETER);
+        CHECK(now_seconds() - t0 < 0.5, "%s checked before any work", bad[i].name);
+        CHECK(p == sentinel, "no output on failure (%s)", bad[i].name);
+        sc_params_free(params);
+        params = NULL;
+    }
+    /* Accessors on NULL. */
+    CHECK(sc_pointwise_n_vertices(NULL, SC_SIDE_B) == 0, "NULL has no vertices");
+    CHECK(sc_pointwise_fmap_rows(NULL) == 0 && sc_pointwise_fmap_cols(NULL) == 0, "NULL fmap");
+    CHECK_STATUS(sc_pointwise_map_b_to_a(NULL, NULL, 0), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_fmap(NULL, NULL, 0), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_regions(NULL, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_seconds(NULL, "total", &t0), SC_STATUS_NULL_ARGUMENT);
+    sc_pointwise_free(NULL);
+    sc_shape_free(a);
+}
+
+/* B is A with its vertices permuted (vertex j of B is vertex perm[j] of A) and its
+ * triangles re-indexed: an isometric copy, so the map from B to A composed with the
+ * permutation is the identity. */
+static void test_pointwise_permuted_copy(void) {
+    sc_shape *a = figure("humanoid", 3), *b = NULL;
+    sc_params *params = NULL;
+    sc_pointwise *p = NULL;
+    sc_correspondence *regions = NULL;
+    struct progress_log log = {0, 0, 0, 0, 0.0};
+    size_t n, nt, i, exact = 0, rows, cols;
+    size_t *perm, *inverse;
+    uint32_t *tri_a, *tri_b, *map;
+    double *xyz_a, *xyz_b, *fmap, lo[3], hi[3], diagonal = 0.0, error = 0.0, seconds, total;
+    unsigned seed = 2024u;
+    int k;
+    if (a == NULL)
+        return;
+    n = sc_shape_n_vertices(a);
+    nt = sc_shape_n_triangles(a);
+    perm = malloc(n * sizeof *perm);
+    inverse = malloc(n * sizeof *inverse);
+    xyz_a = malloc(3 * n * sizeof *xyz_a);
+    xyz_b = malloc(3 * n * sizeof *xyz_b);
+    tri_a = malloc(3 * nt * sizeof *tri_a);
+    tri_b = malloc(3 * nt * sizeof *tri_b);
+    map = malloc(n * sizeof *map);
+    CHECK_STATUS(sc_shape_vertices(a, xyz_a, 3 * n), SC_STATUS_OK);
+    CHECK_STATUS(sc_shape_triangles(a, tri_a, 3 * nt), SC_STATUS_OK);
+    for (i = 0; i < n; i++)
+        perm[i] = i;
+    for (i = n - 1; i > 0; i--) { /* Fisher-Yates with a fixed LCG */
+        size_t j, t;
+        seed = seed * 1103515245u + 12345u;
+        j = (size_t)(seed >> 8) % (i + 1);
+        t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+    for (i = 0; i < n; i++) {
+        inverse[perm[i]] = i;
+        for (k = 0; k < 3; k++)
+            xyz_b[3 * i + k] = xyz_a[3 * perm[i] + k];
+    }
+    for (i = 0; i < 3 * nt; i++)
+        tri_b[i] = (uint32_t)inverse[tri_a[i]];
+    CHECK_STATUS(sc_shape_new_mesh(xyz_b, n, tri_b, nt, &b), SC_STATUS_OK);
+
+    params = pointwise_params();
+    CHECK_STATUS(sc_pointwise_map(a, b, params, record_progress, &log, &p), SC_STATUS_OK);
+    CHECK(log.calls > 5 && log.bad == 0, "%d progress calls, %d bad", log.calls, log.bad);
+    CHECK(log.last_stage == SC_STAGE_POINTWISE_MAP, "last stage %u", log.last_stage);
+    if (p == NULL)
+        goto done;
+    CHECK(sc_pointwise_n_vertices(p, SC_SIDE_A) == n, "n A");
+    CHECK(sc_pointwise_n_vertices(p, SC_SIDE_B) == n, "n B");
+    CHECK(sc_pointwise_n_vertices(p, 2) == 0, "bad side counts 0");
+
+    /* Wrong buffer sizes and NULL buffers fail and leave the buffer untouched. */
+    memset(map, 0xAB, n * sizeof *map);
+    CHECK_STATUS(sc_pointwise_map_b_to_a(p, map, n - 1), SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_pointwise_map_b_to_a(p, map, 0), SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_pointwise_map_b_to_a(p, NULL, n), SC_STATUS_NULL_ARGUMENT);
+    for (i = 0; i < n; i++)
+        if (map[i] != 0xABABABABu)
+            break;
+    CHECK(i == n, "buffer touched at %zu by a failed call", i);
+    CHECK_STATUS(sc_pointwise_map_b_to_a(p, map, n), SC_STATUS_OK);
+
+    for (k = 0; k < 3; k++) {
+        lo[k] = hi[k] = xyz_a[k];
+        for (i = 1; i < n; i++) {
+            lo[k] = fmin(lo[k], xyz_a[3 * i + k]);
+            hi[k] = fmax(hi[k], xyz_a[3 * i + k]);
+        }
+        diagonal += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    diagonal = sqrt(diagonal);
+    for (i = 0; i < n; i++) {
+        double d = 0.0;
+        CHECK(map[i] < n, "map[%zu] = %u is a vertex of A", i, map[i]);
+        if (map[i] >= n)
+            continue;
+        exact += map[i] == perm[i];
+        for (k = 0; k < 3; k++)
+            d += (xyz_a[3 * map[i] + k] - xyz_a[3 * perm[i] + k]) *
+                 (xyz_a[3 * map[i] + k] - xyz_a[3 * perm[i] + k]);
+        error += sqrt(d);
+    }
+    error /= (double)n * diagonal;
+    printf("pointwise, permuted copy of %zu vertices: %.3f exactly right, mean error %.5f of "
+           "the diagonal\n",
+           n, (double)exact / (double)n, error);
+    CHECK((double)exact >= 0.95 * (double)n, "%.3f exactly right", (double)exact / (double)n);
+    CHECK(error < 0.005, "mean error %.5f of the bounding-box diagonal", error);
+
+    /* The functional map: ZoomOut's final size, finite, and constants map to constants
+     * (both shapes have unit area, so |C[0][0]| = 1 for any vertex map). */
+    rows = sc_pointwise_fmap_rows(p);
+    cols = sc_pointwise_fmap_cols(p);
+    CHECK(rows == (size_t)p2p_eigenpairs() && cols == rows, "fmap %zu x %zu", rows, cols);
+    fmap = malloc((rows * cols + 1) * sizeof *fmap);
+    fmap[0] = -7.0;
+    CHECK_STATUS(sc_pointwise_fmap(p, fmap, rows * cols - 1), SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK(fmap[0] == -7.0, "fmap buffer untouched on failure");
+    CHECK_STATUS(sc_pointwise_fmap(p, fmap, rows * cols + 1), SC_STATUS_OK);
+    for (i = 0; i < rows * cols; i++)
+        CHECK(isfinite(fmap[i]), "fmap[%zu] = %g", i, fmap[i]);
+    CHECK(fabs(fabs(fmap[0]) - 1.0) < 1e-6, "C[0][0] = %.9f", fmap[0]);
+    free(fmap);
+
+    /* The region correspondence it was built on: an independent handle. */
+    CHECK_STATUS(sc_pointwise_regions(p, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_regions(p, &regions), SC_STATUS_OK);
+    CHECK(sc_correspondence_n_vertices(regions, SC_SIDE_B) == n, "regions of B");
+    CHECK(sc_correspondence_n_matches(regions, SC_MATCHES_ONE_TO_ONE) >= 5, "%zu matches",
+          sc_correspondence_n_matches(regions, SC_MATCHES_ONE_TO_ONE));
+
+    CHECK_STATUS(sc_pointwise_seconds(p, "total", &total), SC_STATUS_OK);
+    CHECK_STATUS(sc_pointwise_seconds(p, "eigenbasis_a", &seconds), SC_STATUS_OK);
+    CHECK(total > 0.0 && seconds > 0.0 && seconds <= total, "timings %g of %g", seconds, total);
+    CHECK_STATUS(sc_pointwise_seconds(p, "refinement", &seconds), SC_STATUS_OK);
+    CHECK(seconds > 0.0 && seconds <= total, "refinement %g of %g", seconds, total);
+    seconds = -1.0;
+    CHECK_STATUS(sc_pointwise_seconds(p, "lunch", &seconds), SC_STATUS_INVALID_ARGUMENT);
+    CHECK(seconds == -1.0, "no output for an unknown stage");
+    CHECK_STATUS(sc_pointwise_seconds(p, NULL, &seconds), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_seconds(p, "total", NULL), SC_STATUS_NULL_ARGUMENT);
+    /* The copy outlives the map. */
+    sc_pointwise_free(p);
+    p = NULL;
+    CHECK(sc_correspondence_n_vertices(regions, SC_SIDE_A) == n, "regions outlive the map");
+done:
+    sc_correspondence_free(regions);
+    sc_pointwise_free(p);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+    free(perm);
+    free(inverse);
+    free(xyz_a);
+    free(xyz_b);
+    free(tri_a);
+    free(tri_b);
+    free(map);
+}
+
+/* Cancelling at the pointwise stage: the call stops at once, nothing is written. */
+static void test_pointwise_cancellation(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 1);
+    sc_params *params = pointwise_params();
+    sc_pointwise *sentinel = (sc_pointwise *)(void *)&checks, *p = sentinel;
+    struct progress_log log = {0, 0, 0, SC_STAGE_POINTWISE_MAP, 0.0};
+    double latency;
+    if (a == NULL || b == NULL)
+        return;
+    CHECK_STATUS(sc_pointwise_map(a, b, params, record_progress, &log, &p),
+                 SC_STATUS_CANCELLED);
+    latency = now_seconds() - log.cancelled_at;
+    CHECK(log.cancelled_at > 0.0, "stage %u was reported", SC_STAGE_POINTWISE_MAP);
+    CHECK(latency < 0.5, "stopped %.3f s after the cancel", latency);
+    CHECK(log.bad == 0, "%d bad progress calls", log.bad);
+    CHECK(p == sentinel, "no output when cancelled");
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
 /* --------------------------------------------------------------------- concurrency */
 
 struct shared_work {
@@ -590,6 +874,10 @@ int main(void) {
     test_point_cloud();
     test_cancellation();
     test_symmetry();
+    test_pointwise_options();
+    test_pointwise_errors();
+    test_pointwise_permuted_copy();
+    test_pointwise_cancellation();
     test_concurrency();
     printf("%d checks, %d failures%s\n", checks, failures, quick ? " (quick)" : "");
     return failures == 0 ? 0 : 1;

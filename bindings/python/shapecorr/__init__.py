@@ -9,6 +9,8 @@ A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
     result.regions_a            # region of every vertex of A (numpy uint32)
     result.matches_one_to_one   # (n, 2) array of (region of A, region of B)
     result.colors("a")          # (n_vertices, 4) RGBA bytes, matched regions share a colour
+    pointwise = shapecorr.pointwise_map(a, b)
+    pointwise.map_b_to_a        # vertex of A for every vertex of B (numpy uint32)
 
 Options are the library's named options (``shapecorr.options()``), with the same defaults as
 the command line. Errors raise :class:`ShapecorrError` with the C status and the message.
@@ -17,6 +19,7 @@ works (ctypes does).
 """
 
 import ctypes
+import functools
 import weakref
 
 import numpy as np
@@ -29,8 +32,10 @@ __all__ = [
     "Shape",
     "Correspondence",
     "Symmetry",
+    "PointwiseMap",
     "match",
     "detect_symmetry",
+    "pointwise_map",
     "options",
     "version",
 ]
@@ -396,3 +401,69 @@ def detect_symmetry(shape, progress=None, **options):
     status = lib.sc_symmetry_detect(shape, params, callback.c_function, None, ctypes.byref(out))
     callback.finish(status)
     return Symmetry(out.value)
+
+
+class PointwiseMap(_Handle):
+    """The result of :func:`pointwise_map` (immutable; safe to share between threads)."""
+
+    _free = lib.sc_pointwise_free
+
+    @property
+    def n_vertices_a(self):
+        return lib.sc_pointwise_n_vertices(self, _lib.SIDE_A)
+
+    @property
+    def n_vertices_b(self):
+        return lib.sc_pointwise_n_vertices(self, _lib.SIDE_B)
+
+    @property
+    def map_b_to_a(self):
+        """For every vertex of B (input order), the vertex of A it corresponds to: a uint32
+        array of ``n_vertices_b`` values below ``n_vertices_a``."""
+        return _fill(
+            lib.sc_pointwise_map_b_to_a, self, shape=self.n_vertices_b, dtype=np.uint32,
+            ctype=ctypes.c_uint32,
+        )
+
+    @property
+    def fmap(self):
+        """The functional map from A to B, a (k_b, k_a) float64 array: it takes a function's
+        coefficients in A's Laplacian eigenbasis to the transported function's on B."""
+        rows, cols = lib.sc_pointwise_fmap_rows(self), lib.sc_pointwise_fmap_cols(self)
+        return _fill(lib.sc_pointwise_fmap, self, shape=(rows, cols), dtype=np.float64, ctype=ctypes.c_double)
+
+    @functools.cached_property
+    def regions(self):
+        """The region correspondence the map was built on (a :class:`Correspondence`; its
+        timings count the region stages only)."""
+        return Correspondence(_new_handle(lib.sc_pointwise_regions, self))
+
+    @property
+    def timings(self):
+        """Seconds per stage: ``eigenbasis_a``, ``eigenbasis_b``, ``regions``, ``fmap``,
+        ``refinement`` and ``total``."""
+        out = {}
+        for stage in ("eigenbasis_a", "eigenbasis_b", "regions", "fmap", "refinement", "total"):
+            value = ctypes.c_double()
+            _check(lib.sc_pointwise_seconds(self, stage.encode(), ctypes.byref(value)))
+            out[stage] = value.value
+        return out
+
+    def __repr__(self):
+        return f"<shapecorr.PointwiseMap {self.n_vertices_b} vertices of B -> {self.n_vertices_a} of A>"
+
+
+def pointwise_map(a, b, progress=None, **options):
+    """Point-to-point map from shape ``b`` to shape ``a``: the region correspondence of
+    :func:`match`, then a functional map constrained by the matched regions, refined by
+    ZoomOut. ``options`` are named options as for :func:`match`, plus the pointwise map's
+    (``p2p_fmap_size=40``, ``p2p_regions=1`` (0 none, 1 one-to-one, 2 symmetric),
+    ``p2p_refinement=1`` (0 none, 1 ZoomOut, 2 ICP), ``p2p_wks=False``, ...; see
+    :func:`options`). ``progress`` as for :func:`match`; the last stage is
+    ``"pointwise_map"``. Returns a :class:`PointwiseMap`."""
+    params = _Params(options)
+    callback = _Progress(progress)
+    out = ctypes.c_void_p()
+    status = lib.sc_pointwise_map(a, b, params, callback.c_function, None, ctypes.byref(out))
+    callback.finish(status)
+    return PointwiseMap(out.value)

@@ -130,6 +130,16 @@ FUNCTIONS = {
     "sc_symmetry_regions": (status, [handle, c_u32p, c_size_t]),
     "sc_symmetry_region_groups": (status, [handle, c_u32p, c_size_t]),
     "sc_symmetry_colors": (status, [handle, c_u8p, c_size_t]),
+    # pointwise maps
+    "sc_pointwise_map": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
+    "sc_pointwise_free": (None, [handle]),
+    "sc_pointwise_n_vertices": (c_size_t, [handle, c_u32]),
+    "sc_pointwise_map_b_to_a": (status, [handle, c_u32p, c_size_t]),
+    "sc_pointwise_fmap_rows": (c_size_t, [handle]),
+    "sc_pointwise_fmap_cols": (c_size_t, [handle]),
+    "sc_pointwise_fmap": (status, [handle, c_f64p, c_size_t]),
+    "sc_pointwise_regions": (status, [handle, handle_out]),
+    "sc_pointwise_seconds": (status, [handle, c_str, c_f64p]),
 }
 
 for _name, (_restype, _argtypes) in FUNCTIONS.items():
@@ -147,6 +157,8 @@ if lib.sc_abi_version() != ABI_VERSION:
 SIDE_A, SIDE_B = 0, 1
 MATCHES_SYMMETRIC, MATCHES_ONE_TO_ONE = 0, 1
 OPTION_INT, OPTION_DOUBLE, OPTION_BOOL = 0, 1, 2
+P2P_REGIONS_NONE, P2P_REGIONS_ONE_TO_ONE, P2P_REGIONS_SYMMETRIC = 0, 1, 2
+P2P_REFINEMENT_NONE, P2P_REFINEMENT_ZOOMOUT, P2P_REFINEMENT_ICP = 0, 1, 2
 STATUS_NAMES = {
     0: "OK",
     1: "NULL_ARGUMENT",
@@ -171,4 +183,5 @@ STAGE_NAMES = {
     4: "segmentation",
     5: "matching",
     6: "symmetry_breaking",
+    7: "pointwise_map",
 }

@@ -303,3 +303,146 @@ def test_readme_python_example(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert "region 0 of A" in done.stdout, done.stdout
+
+
+# ------------------------------------------------------------------------- pointwise maps
+
+
+def permuted_copy(shape, seed):
+    """B = A with its vertices permuted (vertex j of B is vertex perm[j] of A) and its
+    triangles re-indexed: an isometric copy whose true map from B to A is ``perm``."""
+    perm = np.random.default_rng(seed).permutation(shape.n_vertices)
+    inverse = np.empty_like(perm)
+    inverse[perm] = np.arange(len(perm))
+    return shapecorr.Shape.mesh(shape.vertices[perm], inverse[shape.triangles]), perm
+
+
+def test_pointwise_options_and_defaults():
+    table = {name: (kind, default) for name, kind, doc, default in shapecorr.options()}
+    assert table["p2p_eigenpairs"] == ("int", 100)
+    assert table["p2p_fmap_size"] == ("int", 40)
+    assert table["p2p_regions"] == ("int", _lib.P2P_REGIONS_ONE_TO_ONE)
+    assert table["p2p_refinement"] == ("int", _lib.P2P_REFINEMENT_ZOOMOUT)
+    assert table["p2p_region_distances"] == ("bool", True)
+    assert table["p2p_wks"] == ("bool", False)
+    assert table["p2p_laplacian_weight"] == ("float", 1.0)
+    assert table["p2p_zoomout_end"] == ("int", 100)
+
+
+def test_permuted_copy_is_mapped_back(humanoids):
+    a = shapecorr.Shape.figure("humanoid", 3, SIZE)
+    b, perm = permuted_copy(a, seed=5)
+    stages = []
+    result = shapecorr.pointwise_map(a, b, progress=lambda stage, f: stages.append((stage, f)) or True)
+    assert stages[-1][0] == "pointwise_map" and all(0.0 <= f <= 1.0 for _, f in stages)
+    assert {s for s, _ in stages} >= {"eigenbasis", "segmentation", "matching", "pointwise_map"}
+    assert (result.n_vertices_a, result.n_vertices_b) == (a.n_vertices, b.n_vertices)
+    mapped = result.map_b_to_a
+    assert mapped.dtype == np.uint32 and mapped.shape == (b.n_vertices,)
+    assert mapped.max() < a.n_vertices
+    exact = float(np.mean(mapped == perm))
+    v = a.vertices
+    diagonal = np.linalg.norm(v.max(axis=0) - v.min(axis=0))
+    error = np.linalg.norm(v[mapped] - v[perm], axis=1).mean() / diagonal
+    assert exact >= 0.95, exact
+    assert error < 0.005, error
+    fmap = result.fmap
+    assert fmap.dtype == np.float64 and fmap.shape == (100, 100)
+    assert np.all(np.isfinite(fmap))
+    # Both shapes have unit area, so constants map to constants: |C[0, 0]| = 1.
+    assert abs(abs(fmap[0, 0]) - 1.0) < 1e-6
+    regions = result.regions
+    assert isinstance(regions, shapecorr.Correspondence)
+    assert regions is result.regions
+    assert regions.regions_b.shape == (b.n_vertices,) and len(regions.matches_one_to_one) >= 5
+    timings = result.timings
+    assert set(timings) == {"eigenbasis_a", "eigenbasis_b", "regions", "fmap", "refinement", "total"}
+    assert 0 < timings["eigenbasis_a"] <= timings["total"]
+    assert "PointwiseMap" in repr(result)
+
+
+@pytest.mark.parametrize(
+    "options, size",
+    [
+        (dict(p2p_refinement=_lib.P2P_REFINEMENT_ICP), 40),
+        (dict(p2p_refinement=_lib.P2P_REFINEMENT_NONE), 40),
+        (dict(p2p_regions=_lib.P2P_REGIONS_SYMMETRIC), 100),
+        (dict(p2p_regions=_lib.P2P_REGIONS_NONE, p2p_wks=True), 100),
+        (dict(p2p_eigenpairs=60, p2p_zoomout_end=60, p2p_fmap_size=20), 60),
+    ],
+)
+def test_every_method_maps_a_permuted_copy_back(options, size):
+    a = shapecorr.Shape.figure("humanoid", 3, 1500)
+    b, perm = permuted_copy(a, seed=9)
+    result = shapecorr.pointwise_map(a, b, **options)
+    assert result.fmap.shape == (size, size), options
+    assert np.mean(result.map_b_to_a == perm) >= 0.95, options
+
+
+def test_two_poses_are_mapped_up_to_the_mirror(humanoids):
+    """Poses of one figure share the vertex order, so the truth is the identity, or its
+    mirror image (the rest pose is symmetric under x -> -x; a left/right flip is allowed)."""
+    a, b = humanoids
+    mapped = shapecorr.pointwise_map(a, b).map_b_to_a
+    v = a.vertices
+    mirrored = v * np.array([-1.0, 1.0, 1.0])
+    mirror = np.array([np.argmin(np.sum((v - p) ** 2, axis=1)) for p in mirrored])
+    assert np.allclose(v[mirror], mirrored, atol=1e-9), "the rest pose is symmetric"
+    diagonal = np.linalg.norm(v.max(axis=0) - v.min(axis=0))
+    plain = np.linalg.norm(v[mapped] - v, axis=1).mean() / diagonal
+    flipped = np.linalg.norm(v[mirror[mapped]] - v, axis=1).mean() / diagonal
+    assert min(plain, flipped) < 0.04, (plain, flipped)
+
+
+def test_pointwise_option_errors(humanoids):
+    a, b = humanoids
+    for bad in [dict(p2p_fmap_size=2.5), dict(p2p_wks=1), dict(p2p_regions=True)]:
+        with pytest.raises(ShapecorrError) as error:
+            shapecorr.pointwise_map(a, b, **bad)
+        assert error.value.status_name == "INVALID_ARGUMENT", bad
+    for bad in [
+        dict(p2p_regions=3),
+        dict(p2p_refinement=-1),
+        dict(p2p_laplacian_weight=math.inf),
+        dict(p2p_fmap_size=120),
+        dict(p2p_zoomout_end=150),
+        dict(p2p_regions=_lib.P2P_REGIONS_NONE),
+        dict(k_min=8, k_max=5),
+    ]:
+        with pytest.raises(ShapecorrError) as error:
+            shapecorr.pointwise_map(a, b, **bad)
+        assert error.value.status_name == "INVALID_PARAMETER", bad
+    with pytest.raises(ShapecorrError) as error:
+        shapecorr.pointwise_map(a, b, p2p_nonsense=1)
+    assert error.value.status_name == "UNKNOWN_OPTION"
+
+
+def test_pointwise_cancellation_and_raw_api_errors(humanoids):
+    a, b = humanoids
+    with pytest.raises(ShapecorrError) as error:
+        shapecorr.pointwise_map(a, b, progress=lambda stage, f: stage != "pointwise_map")
+    assert error.value.status_name == "CANCELLED"
+    lib = _lib.lib
+    out = ctypes.c_void_p()
+    assert lib.sc_pointwise_map(None, b, None, _lib.PROGRESS(), None, ctypes.byref(out)) == 1
+    assert lib.sc_pointwise_map(a, b, None, _lib.PROGRESS(), None, None) == 1
+    assert "out_pointwise" in lib.sc_last_error().decode()
+    assert out.value is None, "nothing written on failure"
+    assert lib.sc_pointwise_n_vertices(None, _lib.SIDE_B) == 0
+    result = shapecorr.pointwise_map(a, b, p2p_refinement=_lib.P2P_REFINEMENT_NONE)
+    assert result.fmap.shape == (40, 40), "unrefined: the first map's size"
+    n = result.n_vertices_b
+    buffer = np.full(n, 7, dtype=np.uint32)
+    status = lib.sc_pointwise_map_b_to_a(result, buffer.ctypes.data_as(_lib.c_u32p), n - 1)
+    assert _lib.STATUS_NAMES[status] == "BUFFER_TOO_SMALL"
+    assert np.all(buffer == 7), "nothing written on failure"
+    assert lib.sc_pointwise_map_b_to_a(result, None, n) == 1
+    with pytest.raises(ShapecorrError) as error:
+        _check_seconds(result, "lunch")
+    assert error.value.status_name == "INVALID_ARGUMENT"
+
+
+def _check_seconds(result, stage):
+    value = ctypes.c_double()
+    shapecorr._check(_lib.lib.sc_pointwise_seconds(result, stage.encode(), ctypes.byref(value)))
+    return value.value

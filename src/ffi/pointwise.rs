@@ -1,0 +1,257 @@
+//! Point-to-point maps between two shapes: `sc_pointwise_map` and the result's accessors.
+
+use std::ffi::{c_char, c_void};
+
+use super::boundary::{
+    boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
+    Failure, FfiResult, ScStatus,
+};
+use super::correspondence::{ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
+use super::params::{options_or_default, ScParams};
+use super::shape::ScShape;
+use super::{CallbackProgress, ScProgressCallback};
+use crate::pointwise::PointwiseCorrespondence;
+
+/// The result of `sc_pointwise_map`: a vertex map from B to A, the functional map from A to
+/// B and the region correspondence it was built on. Immutable: one handle may be read from
+/// several threads at once. Free it with `sc_pointwise_free`.
+pub struct ScPointwise {
+    pub(crate) result: PointwiseCorrespondence,
+}
+
+/// Option `p2p_regions`: no region constraint (then `p2p_wks` must be true).
+pub const SC_P2P_REGIONS_NONE: i64 = 0;
+/// Option `p2p_regions`: one constraint per one-to-one region match (the default).
+pub const SC_P2P_REGIONS_ONE_TO_ONE: i64 = 1;
+/// Option `p2p_regions`: one constraint per group of symmetric region matches.
+pub const SC_P2P_REGIONS_SYMMETRIC: i64 = 2;
+/// Option `p2p_refinement`: the first functional map's vertex map, unrefined.
+pub const SC_P2P_REFINEMENT_NONE: i64 = 0;
+/// Option `p2p_refinement`: ZoomOut (the default).
+pub const SC_P2P_REFINEMENT_ZOOMOUT: i64 = 1;
+/// Option `p2p_refinement`: spectral ICP.
+pub const SC_P2P_REFINEMENT_ICP: i64 = 2;
+
+/// Point-to-point map from shape `b` to shape `a` (meshes, point clouds or one of each):
+/// the region correspondence of `sc_match`, then a functional map constrained by the matched
+/// regions (options `p2p_*`), converted to a vertex map and refined. Each shape's eigenbasis
+/// is computed once for both steps. Arguments as `sc_match`: `params` may be NULL for the
+/// defaults, `progress` may be NULL; the progress stages are `sc_match`'s followed by
+/// `SC_STAGE_POINTWISE_MAP`. The result is deterministic for given shapes and parameters,
+/// whatever the number of threads.
+///
+/// Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work, e.g. `p2p_fmap_size`
+/// above `p2p_eigenpairs`, or no region constraint and no descriptor),
+/// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+///
+/// # Safety
+/// `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,
+/// `progress` NULL or a function safe to call with `userdata`; `out_pointwise` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_map(
+    a: *const ScShape,
+    b: *const ScShape,
+    params: *const ScParams,
+    progress: ScProgressCallback,
+    userdata: *mut c_void,
+    out_pointwise: *mut *mut ScPointwise,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_pointwise, "out_pointwise")?;
+        let a = &handle(a, "a")?.shape;
+        let b = &handle(b, "b")?.shape;
+        let options = options_or_default(params);
+        let mut progress = CallbackProgress {
+            callback: progress,
+            userdata,
+        };
+        let result = PointwiseCorrespondence::compute(
+            a,
+            b,
+            &options.params,
+            options.pointwise(),
+            &mut progress,
+        )?;
+        give_handle(out_pointwise, ScPointwise { result })
+    })
+}
+
+/// Frees a pointwise map; NULL is a no-op.
+///
+/// # Safety
+/// `pointwise` must be NULL or live, not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_free(pointwise: *mut ScPointwise) {
+    free_handle(pointwise)
+}
+
+unsafe fn count(p: *const ScPointwise, f: impl FnOnce(&ScPointwise) -> FfiResult<usize>) -> usize {
+    boundary_value(0, || f(handle(p, "pointwise")?))
+}
+
+/// Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`, as given to
+/// `sc_pointwise_map`); 0 for NULL or a bad side. The map has `SC_SIDE_B`'s count of
+/// values, each below `SC_SIDE_A`'s count.
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_n_vertices(
+    pointwise: *const ScPointwise,
+    side: u32,
+) -> usize {
+    count(pointwise, |p| match side {
+        SC_SIDE_A => Ok(p.result.regions.graph_a.labels.len()),
+        SC_SIDE_B => Ok(p.result.map.p2p_ba.len()),
+        _ => Err(Failure::invalid(format!(
+            "side must be SC_SIDE_A (0) or SC_SIDE_B (1), got {side}"
+        ))),
+    })
+}
+
+/// Copies the map from B to A: for every vertex `v` of B, in the caller's vertex order, the
+/// vertex of A it corresponds to (`sc_pointwise_n_vertices(p, SC_SIDE_B)` values, each below
+/// `sc_pointwise_n_vertices(p, SC_SIDE_A)`) into `out_map` of `len` elements.
+///
+/// # Safety
+/// `pointwise` must be live; `out_map` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_map_b_to_a(
+    pointwise: *const ScPointwise,
+    out_map: *mut u32,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let p = handle(pointwise, "pointwise")?;
+        write_output(out_map, len, &p.result.map.p2p_ba, "out_map")
+    })
+}
+
+/// Rows of the functional map from A to B: the number of B's basis functions (0 for NULL).
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_fmap_rows(pointwise: *const ScPointwise) -> usize {
+    count(pointwise, |p| Ok(p.result.map.fmap_ab.nrows()))
+}
+
+/// Columns of the functional map from A to B: the number of A's basis functions (0 for
+/// NULL).
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_fmap_cols(pointwise: *const ScPointwise) -> usize {
+    count(pointwise, |p| Ok(p.result.map.fmap_ab.ncols()))
+}
+
+/// Copies the final functional map from A to B, row by row (`rows * cols` values, see
+/// `sc_pointwise_fmap_rows` and `_cols`), into `out_fmap` of `len` elements: it maps the
+/// spectral coefficients of a function on A (in A's Laplacian eigenbasis) to those of the
+/// transported function on B.
+///
+/// # Safety
+/// `pointwise` must be live; `out_fmap` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_fmap(
+    pointwise: *const ScPointwise,
+    out_fmap: *mut f64,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let fmap = &handle(pointwise, "pointwise")?.result.map.fmap_ab;
+        let flat: Vec<f64> = (0..fmap.nrows())
+            .flat_map(|i| (0..fmap.ncols()).map(move |j| fmap[(i, j)]))
+            .collect();
+        write_output(out_fmap, len, &flat, "out_fmap")
+    })
+}
+
+/// The region correspondence the map was built on, as a new `sc_correspondence` (a copy the
+/// caller frees with `sc_correspondence_free`, independent of `pointwise`). Its timings count
+/// the region stages only: the eigenbases' are `sc_pointwise_seconds`'.
+///
+/// # Safety
+/// `pointwise` must be live; `out_correspondence` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_regions(
+    pointwise: *const ScPointwise,
+    out_correspondence: *mut *mut ScCorrespondence,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_correspondence, "out_correspondence")?;
+        let p = handle(pointwise, "pointwise")?;
+        give_handle(
+            out_correspondence,
+            ScCorrespondence {
+                result: p.result.regions.clone(),
+            },
+        )
+    })
+}
+
+/// Seconds spent in a stage of the call: `stage` is one of `"eigenbasis_a"`,
+/// `"eigenbasis_b"`, `"regions"` (the region correspondence after the eigenbases), `"fmap"`
+/// (descriptors and the first functional map), `"refinement"` (the vertex map and its
+/// refinement), `"total"`.
+///
+/// # Safety
+/// `pointwise` must be live; `stage` a NUL-terminated string; `out_seconds` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_seconds(
+    pointwise: *const ScPointwise,
+    stage: *const c_char,
+    out_seconds: *mut f64,
+) -> ScStatus {
+    boundary(|| {
+        let p = &handle(pointwise, "pointwise")?.result;
+        let stage = input_str(stage, "stage")?;
+        let out = out_seconds
+            .as_mut()
+            .ok_or_else(|| Failure::null("out_seconds"))?;
+        *out = match stage {
+            "eigenbasis_a" => p.eigenbasis_a,
+            "eigenbasis_b" => p.eigenbasis_b,
+            "regions" => p.regions.timings.total,
+            "fmap" => p.map.timings.fmap,
+            "refinement" => p.map.timings.refinement,
+            "total" => p.total,
+            other => {
+                return Err(Failure::invalid(format!(
+                    "unknown stage `{other}`; use eigenbasis_a, eigenbasis_b, regions, fmap, \
+                     refinement or total"
+                )))
+            }
+        };
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::options::{
+        P2P_REFINEMENT_ICP, P2P_REFINEMENT_NONE, P2P_REFINEMENT_ZOOMOUT, P2P_REGIONS,
+    };
+    use crate::pointwise::RegionConstraints;
+
+    #[test]
+    fn header_choice_constants_match_the_options() {
+        assert_eq!(
+            P2P_REGIONS[SC_P2P_REGIONS_NONE as usize],
+            RegionConstraints::None
+        );
+        assert_eq!(
+            P2P_REGIONS[SC_P2P_REGIONS_ONE_TO_ONE as usize],
+            RegionConstraints::OneToOne
+        );
+        assert_eq!(
+            P2P_REGIONS[SC_P2P_REGIONS_SYMMETRIC as usize],
+            RegionConstraints::Symmetric
+        );
+        assert_eq!(SC_P2P_REFINEMENT_NONE, P2P_REFINEMENT_NONE);
+        assert_eq!(SC_P2P_REFINEMENT_ZOOMOUT, P2P_REFINEMENT_ZOOMOUT);
+        assert_eq!(SC_P2P_REFINEMENT_ICP, P2P_REFINEMENT_ICP);
+    }
+}
