@@ -252,11 +252,7 @@ pub fn bench_pointwise(
     limit: Option<usize>,
     report: &mut dyn FnMut(usize, usize, &PairScores),
 ) -> Result<Vec<PairScores>> {
-    let layout = Layout::from_pairs_file(pairs_file)?;
-    let mut pairs = read_pairs(pairs_file)?;
-    if let Some(limit) = limit {
-        pairs.truncate(limit);
-    }
+    let (layout, pairs) = pair_list(pairs_file, limit)?;
     let mut methods = methods(pointwise, params);
     if let Some(only) = only {
         if let Some(unknown) = only.iter().find(|o| !methods.iter().any(|(m, _)| m == *o)) {
@@ -338,11 +334,7 @@ pub fn bench_map_files(
     limit: Option<usize>,
     report: &mut dyn FnMut(usize, usize, &PairScores),
 ) -> Result<Vec<PairScores>> {
-    let layout = Layout::from_pairs_file(pairs_file)?;
-    let mut pairs = read_pairs(pairs_file)?;
-    if let Some(limit) = limit {
-        pairs.truncate(limit);
-    }
+    let (layout, pairs) = pair_list(pairs_file, limit)?;
     let mut cache = ShapeCache {
         layout,
         root: root.to_path_buf(),
@@ -367,6 +359,14 @@ pub fn bench_map_files(
         results.push(outcome);
     }
     Ok(results)
+}
+
+/// The layout and the (first `limit`) pairs of a pair list.
+fn pair_list(pairs_file: &Path, limit: Option<usize>) -> Result<(Layout, Vec<Pair>)> {
+    let layout = Layout::from_pairs_file(pairs_file)?;
+    let mut pairs = read_pairs(pairs_file)?;
+    pairs.truncate(limit.unwrap_or(usize::MAX));
+    Ok((layout, pairs))
 }
 
 /// Reads a map file: one 0-based vertex index per line.

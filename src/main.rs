@@ -917,20 +917,7 @@ fn p2p_command(
     value["fmap_size"] = json!(result.map.fmap_ab.nrows());
     write_json(&out.join("result.json"), &value)?;
     write_colored(out, &shape_a, &shape_b, &result.regions)?;
-    let colors_a = coordinate_colors(shape_a.vertices());
-    let colors_b: Vec<[u8; 3]> = map.iter().map(|&v| colors_a[v as usize]).collect();
-    shapecorr::io::write_ply(
-        &out.join("a_colors.ply"),
-        shape_a.vertices(),
-        shape_a.triangles(),
-        Some(&colors_a),
-    )?;
-    shapecorr::io::write_ply(
-        &out.join("b_mapped.ply"),
-        shape_b.vertices(),
-        shape_b.triangles(),
-        Some(&colors_b),
-    )?;
+    write_map_colors(out, &shape_a, &shape_b, map)?;
     println!(
         "map of {} vertices of B onto A ({} one-to-one region matches, functional map {}x{}); {:.2} s -> {}",
         map.len(),
@@ -1174,20 +1161,7 @@ fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
     // geodesic error on A (heat method) at 1000 of the cloud's points.
     let map = PointwiseMap::from_bases(&a, &full_a, &b, &full_b, Some(&result), &pointwise)?;
     write_map(&out.join("map_b_to_a.txt"), &map.p2p_ba)?;
-    let colors_a = coordinate_colors(a.vertices());
-    let colors_b: Vec<[u8; 3]> = map.p2p_ba.iter().map(|&v| colors_a[v as usize]).collect();
-    shapecorr::io::write_ply(
-        &out.join("a_colors.ply"),
-        a.vertices(),
-        a.triangles(),
-        Some(&colors_a),
-    )?;
-    shapecorr::io::write_ply(
-        &out.join("b_mapped.ply"),
-        b.vertices(),
-        b.triangles(),
-        Some(&colors_b),
-    )?;
+    write_map_colors(out, &a, &b, &map.p2p_ba)?;
     let heat = shapecorr::geodesic::HeatGeodesics::new(&a)?;
     let step = (truth.len() / 1000).max(1);
     let sample = |t: &[(u32, u32)]| t.iter().copied().step_by(step).collect::<Vec<_>>();
@@ -1221,6 +1195,25 @@ fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
         out.join("b_mapped.ply").display()
     );
     Ok(())
+}
+
+/// Writes `a_colors.ply` (A coloured by its normalised coordinates) and `b_mapped.ply` (B
+/// with A's colours carried over by the map), to look at a map.
+fn write_map_colors(out: &Path, a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Result<(), Error> {
+    let colors_a = coordinate_colors(a.vertices());
+    let colors_b: Vec<[u8; 3]> = p2p_ba.iter().map(|&v| colors_a[v as usize]).collect();
+    shapecorr::io::write_ply(
+        &out.join("a_colors.ply"),
+        a.vertices(),
+        a.triangles(),
+        Some(&colors_a),
+    )?;
+    shapecorr::io::write_ply(
+        &out.join("b_mapped.ply"),
+        b.vertices(),
+        b.triangles(),
+        Some(&colors_b),
+    )
 }
 
 /// Writes a map file: one 0-based vertex index per line.
