@@ -7,27 +7,32 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use crate::correspondence::{Correspondence, Params};
-use crate::datasets::{read_pairs, Layout, Pair};
-use crate::eigen::Eigenbasis;
+use serde::{Deserialize, Serialize};
+
+use crate::bench_store::{BasisCache, ShapeStore};
+use crate::correspondence::{Correspondence, Params, Timings};
+use crate::datasets::{read_pairs, Dataset, Pair};
 use crate::evaluation::{score_correspondence, RegionScores};
+use crate::pointwise::truncated;
 use crate::progress::NoProgress;
-use crate::shape::Shape;
 use crate::Result;
 
 /// The outcome of one pair.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PairResult {
     pub pair: Pair,
+    /// The number of joint clusters (Reeb baseline: intervals of the function).
     pub k: usize,
     pub scores: RegionScores,
     /// Seconds for the pair as if run alone: both eigenbases plus the matching.
     pub seconds: f64,
+    /// Seconds per stage (the eigenbases as measured when computed).
+    pub timings: Timings,
 }
 
-/// Runs the pairs of `pairs_file` (layout from its name) on the shapes under `root`.
-/// Each shape's eigenbasis is computed once and reused; the time of a pair counts both
-/// eigenbases as if computed for it. `report` is called after every pair.
+/// Runs the pairs of `pairs_file` (the dataset `root/NAME` of `pairs/NAME.txt`) on the shapes
+/// under `root`. Each shape's eigenbasis is computed once and reused; the time of a pair
+/// counts both eigenbases as if computed for it. `report` is called after every pair.
 pub fn bench_regions(
     root: &Path,
     pairs_file: &Path,
@@ -35,51 +40,79 @@ pub fn bench_regions(
     limit: Option<usize>,
     report: &mut dyn FnMut(usize, usize, &PairResult),
 ) -> Result<Vec<PairResult>> {
-    let layout = Layout::from_pairs_file(pairs_file)?;
+    let dataset = Dataset::for_pairs_file(root, pairs_file)?;
     let mut pairs = read_pairs(pairs_file)?;
-    if let Some(limit) = limit {
-        pairs.truncate(limit);
-    }
-    let mut cache: BTreeMap<String, (Shape, Eigenbasis, f64)> = BTreeMap::new();
+    pairs.truncate(limit.unwrap_or(usize::MAX));
+    let mut store = ShapeStore::new(dataset, params.eigen.clone(), BasisCache::default());
     let mut results = Vec::with_capacity(pairs.len());
     for (index, pair) in pairs.iter().enumerate() {
-        for name in [&pair.source, &pair.target] {
-            if !cache.contains_key(name.as_str()) {
-                let shape = Shape::read(&layout.shape_path(root, name), false)?;
-                let t = Instant::now();
-                let basis = Eigenbasis::compute(&shape, &params.eigen)?;
-                cache.insert(name.clone(), (shape, basis, t.elapsed().as_secs_f64()));
-            }
-        }
-        let (a, basis_a, t_a) = &cache[pair.source.as_str()];
-        let (b, basis_b, t_b) = &cache[pair.target.as_str()];
-        let t = Instant::now();
-        let result = Correspondence::from_bases(a, basis_a, b, basis_b, params, &mut NoProgress)?;
-        let seconds = t.elapsed().as_secs_f64() + t_a + t_b;
-        let (truth, flipped) = layout.ground_truth(
-            root,
-            &pair.source,
-            &pair.target,
-            a.n_vertices(),
-            b.n_vertices(),
-        )?;
-        let scores = score_correspondence(
-            &result,
-            &basis_a.mass,
-            &basis_b.mass,
-            &truth,
-            flipped.as_deref(),
-        );
-        let outcome = PairResult {
-            pair: pair.clone(),
-            k: result.k,
-            scores,
-            seconds,
-        };
+        let outcome = region_pair(&mut store, pair, params, &|a, ba, b, bb, p| {
+            Correspondence::from_bases(a, ba, b, bb, p, &mut NoProgress)
+        })?;
         report(index, pairs.len(), &outcome);
         results.push(outcome);
     }
     Ok(results)
+}
+
+/// A region method run on two shapes with their eigenbases: the paper's pipeline
+/// ([`Correspondence::from_bases`]) or a baseline.
+pub type RegionMethod<'a> = dyn Fn(
+        &crate::Shape,
+        &crate::Eigenbasis,
+        &crate::Shape,
+        &crate::Eigenbasis,
+        &Params,
+    ) -> Result<Correspondence>
+    + 'a;
+
+/// One pair of `store`'s dataset: `method` on the two shapes (their eigenbases cut to
+/// `params.eigen.n_eigenpairs` when the store holds more), scored against the ground truth.
+pub fn region_pair(
+    store: &mut ShapeStore,
+    pair: &Pair,
+    params: &Params,
+    method: &RegionMethod,
+) -> Result<PairResult> {
+    store.load(&pair.source, true, false)?;
+    store.load(&pair.target, true, false)?;
+    let (a, b) = (store.get(&pair.source), store.get(&pair.target));
+    let (basis_a, basis_b) = (store.basis(&pair.source), store.basis(&pair.target));
+    let k = params.eigen.n_eigenpairs;
+    let cut = |basis: &crate::Eigenbasis| (basis.len() > k).then(|| truncated(basis, k));
+    let (cut_a, cut_b) = (cut(&basis_a.basis), cut(&basis_b.basis));
+    let t = Instant::now();
+    let mut result = method(
+        &a.shape,
+        cut_a.as_ref().unwrap_or(&basis_a.basis),
+        &b.shape,
+        cut_b.as_ref().unwrap_or(&basis_b.basis),
+        params,
+    )?;
+    let seconds = t.elapsed().as_secs_f64() + basis_a.seconds + basis_b.seconds;
+    result.timings.eigenbasis_a = basis_a.seconds;
+    result.timings.eigenbasis_b = basis_b.seconds;
+    result.timings.total = seconds;
+    let (truth, flipped) = store.dataset.ground_truth(
+        &pair.source,
+        &pair.target,
+        a.shape.n_vertices(),
+        b.shape.n_vertices(),
+    )?;
+    let scores = score_correspondence(
+        &result,
+        &basis_a.basis.mass,
+        &basis_b.basis.mass,
+        &truth,
+        flipped.as_deref(),
+    );
+    Ok(PairResult {
+        pair: pair.clone(),
+        k: result.k,
+        scores,
+        seconds,
+        timings: result.timings,
+    })
 }
 
 /// The results as a table: one row per category and one for all pairs.

@@ -16,14 +16,14 @@ use std::time::Instant;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use crate::bench_store::{BasisCache, ShapeStore};
 use crate::correspondence::{Correspondence, Params};
-use crate::datasets::{read_pairs, Layout, Pair};
+use crate::datasets::{read_pairs, Dataset, Pair};
 use crate::descriptors::WksParams;
-use crate::eigen::{EigenParams, Eigenbasis};
+use crate::eigen::EigenParams;
 use crate::evaluation::{pointwise_errors, ErrorSummary};
-use crate::geodesic::HeatGeodesics;
 use crate::pointwise::{truncated, PointwiseMap, PointwiseParams, Refinement, RegionConstraints};
 use crate::progress::NoProgress;
 use crate::shape::Shape;
@@ -31,6 +31,16 @@ use crate::{Error, Result};
 
 /// Seed of the ground-truth sample.
 const SAMPLE_SEED: u64 = 0x9e0d;
+
+/// Number of points of the stored error curves: thresholds 0, 0.0025, ..., 0.25.
+pub const CURVE_POINTS: usize = 101;
+/// Step between the thresholds of the error curves.
+pub const CURVE_STEP: f64 = 0.0025;
+
+/// The thresholds of the error curves.
+pub fn curve_thresholds() -> Vec<f64> {
+    (0..CURVE_POINTS).map(|i| i as f64 * CURVE_STEP).collect()
+}
 
 /// The methods of the paper's Table 2 plus the refined one: name and parameters, all
 /// derived from `base` (the default pipeline, regions + ZoomOut).
@@ -79,7 +89,7 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
 }
 
 /// One method's scores on one pair.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MapScore {
     pub method: String,
     /// Against the ground truth.
@@ -89,9 +99,11 @@ pub struct MapScore {
     /// Seconds for the pair as if run alone (both eigenbases, the regions where used, the
     /// map); 0 for maps scored from files.
     pub seconds: f64,
-    /// The sampled errors (plain, or mirrored where that mean is lower), for the curves.
-    #[serde(skip)]
-    pub best_errors: Vec<f64>,
+    /// Fraction of the sampled errors (plain, or mirrored where that mean is lower) within
+    /// each of [`curve_thresholds`], for the cumulative curves.
+    pub curve: Vec<f64>,
+    /// Number of ground-truth pairs scored (the weight of `curve` when pairs are pooled).
+    pub n_scored: usize,
 }
 
 impl MapScore {
@@ -109,7 +121,7 @@ impl MapScore {
 }
 
 /// The scores of every method on one pair.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PairScores {
     pub source: String,
     pub target: String,
@@ -117,60 +129,16 @@ pub struct PairScores {
     pub scores: Vec<MapScore>,
 }
 
-/// Shapes, eigenbases and geodesic solvers, each made once per shape.
-struct ShapeCache {
-    layout: Layout,
-    root: std::path::PathBuf,
-    eigen: EigenParams,
-    shapes: BTreeMap<String, CachedShape>,
-}
-
-/// A shape with what has been computed for it so far.
-struct CachedShape {
-    shape: Shape,
-    /// The eigenbasis and the seconds it took.
-    basis: Option<(Eigenbasis, f64)>,
-    heat: Option<HeatGeodesics>,
-}
-
-impl ShapeCache {
-    fn load(&mut self, name: &str, basis: bool, heat: bool) -> Result<()> {
-        if !self.shapes.contains_key(name) {
-            let shape = Shape::read(&self.layout.shape_path(&self.root, name), false)?;
-            self.shapes.insert(
-                name.to_string(),
-                CachedShape {
-                    shape,
-                    basis: None,
-                    heat: None,
-                },
-            );
-        }
-        let entry = self.shapes.get_mut(name).expect("inserted above");
-        if basis && entry.basis.is_none() {
-            let t = Instant::now();
-            let b = Eigenbasis::compute(&entry.shape, &self.eigen)?;
-            entry.basis = Some((b, t.elapsed().as_secs_f64()));
-        }
-        if heat && entry.heat.is_none() {
-            entry.heat = Some(HeatGeodesics::new(&entry.shape)?);
-        }
-        Ok(())
-    }
-}
-
 /// Scores maps `p2p_ba` of one pair against its ground truth (a seeded sample of at most
 /// `samples` pairs; 0 = all).
 fn score_maps(
-    cache: &mut ShapeCache,
+    store: &mut ShapeStore,
     pair: &Pair,
     maps: &[(String, Vec<u32>, f64)],
     samples: usize,
 ) -> Result<Vec<MapScore>> {
-    cache.load(&pair.source, false, true)?;
-    cache.load(&pair.target, false, false)?;
-    let n_a = cache.shapes[&pair.source].shape.n_vertices();
-    let n_b = cache.shapes[&pair.target].shape.n_vertices();
+    let n_a = store.load(&pair.source, false, true)?.shape.n_vertices();
+    let n_b = store.load(&pair.target, false, false)?.shape.n_vertices();
     for (name, map, _) in maps {
         if map.len() != n_b {
             return Err(Error::InvalidParameter {
@@ -192,10 +160,9 @@ fn score_maps(
             });
         }
     }
-    let (truth, mirrored) =
-        cache
-            .layout
-            .ground_truth(&cache.root, &pair.source, &pair.target, n_a, n_b)?;
+    let (truth, mirrored) = store
+        .dataset
+        .ground_truth(&pair.source, &pair.target, n_a, n_b)?;
     let mut chosen: Vec<usize> = (0..truth.len()).collect();
     if samples > 0 && samples < truth.len() {
         chosen.shuffle(&mut ChaCha8Rng::seed_from_u64(SAMPLE_SEED));
@@ -203,7 +170,7 @@ fn score_maps(
         chosen.sort_unstable();
     }
     let pick = |t: &[(u32, u32)]| chosen.iter().map(|&i| t[i]).collect::<Vec<_>>();
-    let entry = &cache.shapes[&pair.source];
+    let entry = store.get(&pair.source);
     let heat = entry.heat.as_ref().expect("loaded above");
     let area_a = shape_area(&entry.shape)?;
     let map_refs: Vec<&[u32]> = maps.iter().map(|(_, m, _)| m.as_slice()).collect();
@@ -219,15 +186,16 @@ fn score_maps(
             let error = ErrorSummary::of(&plain[i]);
             let error_mirrored = flipped.as_ref().map(|f| ErrorSummary::of(&f[i]));
             let best_errors = match (&flipped, error_mirrored) {
-                (Some(f), Some(m)) if m.mean < error.mean => f[i].clone(),
-                _ => plain[i].clone(),
+                (Some(f), Some(m)) if m.mean < error.mean => &f[i],
+                _ => &plain[i],
             };
             MapScore {
                 method: name.clone(),
                 error,
                 error_mirrored,
                 seconds: *seconds,
-                best_errors,
+                curve: crate::evaluation::error_curve(best_errors, &curve_thresholds()),
+                n_scored: best_errors.len(),
             }
         })
         .collect())
@@ -252,8 +220,29 @@ pub fn bench_pointwise(
     limit: Option<usize>,
     report: &mut dyn FnMut(usize, usize, &PairScores),
 ) -> Result<Vec<PairScores>> {
-    let (layout, pairs) = pair_list(pairs_file, limit)?;
-    let mut methods = methods(pointwise, params);
+    let (dataset, pairs) = pair_list(root, pairs_file, limit)?;
+    let methods = select_methods(pointwise, params, only)?;
+    let eigen = EigenParams {
+        n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
+        ..params.eigen.clone()
+    };
+    let mut store = ShapeStore::new(dataset, eigen, BasisCache::default());
+    let mut results = Vec::with_capacity(pairs.len());
+    for (index, pair) in pairs.iter().enumerate() {
+        let outcome = pointwise_pair(&mut store, pair, params, &methods, samples)?;
+        report(index, pairs.len(), &outcome);
+        results.push(outcome);
+    }
+    Ok(results)
+}
+
+/// The methods of [`methods`] named in `only` (all when None); an unknown name is an error.
+pub fn select_methods(
+    base: &PointwiseParams,
+    region_params: &Params,
+    only: Option<&[String]>,
+) -> Result<Vec<(String, PointwiseParams)>> {
+    let mut methods = methods(base, region_params);
     if let Some(only) = only {
         if let Some(unknown) = only.iter().find(|o| !methods.iter().any(|(m, _)| m == *o)) {
             return Err(Error::InvalidParameter {
@@ -270,58 +259,55 @@ pub fn bench_pointwise(
         }
         methods.retain(|(m, _)| only.contains(m));
     }
-    let mut cache = ShapeCache {
-        layout,
-        root: root.to_path_buf(),
-        eigen: EigenParams {
-            n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
-            ..params.eigen.clone()
-        },
-        shapes: BTreeMap::new(),
-    };
-    let mut results = Vec::with_capacity(pairs.len());
-    for (index, pair) in pairs.iter().enumerate() {
-        cache.load(&pair.source, true, false)?;
-        cache.load(&pair.target, true, false)?;
-        let (a, b) = (&cache.shapes[&pair.source], &cache.shapes[&pair.target]);
-        let (basis_a, basis_b) = (
-            a.basis.as_ref().expect("loaded"),
-            b.basis.as_ref().expect("loaded"),
-        );
-        let (a, b) = (&a.shape, &b.shape);
-        let eigen_seconds = basis_a.1 + basis_b.1;
+    Ok(methods)
+}
+
+/// One pair of `store`'s dataset: the regions (on eigenbases cut to
+/// `params.eigen.n_eigenpairs`), then every method's map, scored on `samples` ground-truth
+/// pairs (0 = all). The store's eigenbases need at least the methods' `n_eigenpairs`.
+pub fn pointwise_pair(
+    store: &mut ShapeStore,
+    pair: &Pair,
+    params: &Params,
+    methods: &[(String, PointwiseParams)],
+    samples: usize,
+) -> Result<PairScores> {
+    store.load(&pair.source, true, false)?;
+    store.load(&pair.target, true, false)?;
+    let (a, b) = (
+        &store.get(&pair.source).shape,
+        &store.get(&pair.target).shape,
+    );
+    let (basis_a, basis_b) = (store.basis(&pair.source), store.basis(&pair.target));
+    let eigen_seconds = basis_a.seconds + basis_b.seconds;
+    let t = Instant::now();
+    let regions = Correspondence::from_bases(
+        a,
+        &truncated(&basis_a.basis, params.eigen.n_eigenpairs),
+        b,
+        &truncated(&basis_b.basis, params.eigen.n_eigenpairs),
+        params,
+        &mut NoProgress,
+    )?;
+    let region_seconds = t.elapsed().as_secs_f64();
+    let mut maps = Vec::with_capacity(methods.len());
+    for (name, method) in methods {
         let t = Instant::now();
-        let regions = Correspondence::from_bases(
-            a,
-            &truncated(&basis_a.0, params.eigen.n_eigenpairs),
-            b,
-            &truncated(&basis_b.0, params.eigen.n_eigenpairs),
-            params,
-            &mut NoProgress,
-        )?;
-        let region_seconds = t.elapsed().as_secs_f64();
-        let mut maps = Vec::with_capacity(methods.len());
-        for (name, method) in &methods {
-            let t = Instant::now();
-            let map =
-                PointwiseMap::from_bases(a, &basis_a.0, b, &basis_b.0, Some(&regions), method)?;
-            let uses_regions = method.regions != RegionConstraints::None;
-            let seconds = t.elapsed().as_secs_f64()
-                + eigen_seconds
-                + if uses_regions { region_seconds } else { 0.0 };
-            maps.push((name.clone(), map.p2p_ba, seconds));
-        }
-        let scores = score_maps(&mut cache, pair, &maps, samples)?;
-        let outcome = PairScores {
-            source: pair.source.clone(),
-            target: pair.target.clone(),
-            category: pair.category.clone(),
-            scores,
-        };
-        report(index, pairs.len(), &outcome);
-        results.push(outcome);
+        let map =
+            PointwiseMap::from_bases(a, &basis_a.basis, b, &basis_b.basis, Some(&regions), method)?;
+        let uses_regions = method.regions != RegionConstraints::None;
+        let seconds = t.elapsed().as_secs_f64()
+            + eigen_seconds
+            + if uses_regions { region_seconds } else { 0.0 };
+        maps.push((name.clone(), map.p2p_ba, seconds));
     }
-    Ok(results)
+    let scores = score_maps(store, pair, &maps, samples)?;
+    Ok(PairScores {
+        source: pair.source.clone(),
+        target: pair.target.clone(),
+        category: pair.category.clone(),
+        scores,
+    })
 }
 
 /// Scores maps stored as files `maps_dir/{source}__{target}.txt` (one 0-based vertex of A
@@ -334,13 +320,8 @@ pub fn bench_map_files(
     limit: Option<usize>,
     report: &mut dyn FnMut(usize, usize, &PairScores),
 ) -> Result<Vec<PairScores>> {
-    let (layout, pairs) = pair_list(pairs_file, limit)?;
-    let mut cache = ShapeCache {
-        layout,
-        root: root.to_path_buf(),
-        eigen: EigenParams::default(),
-        shapes: BTreeMap::new(),
-    };
+    let (dataset, pairs) = pair_list(root, pairs_file, limit)?;
+    let mut store = ShapeStore::new(dataset, EigenParams::default(), BasisCache::default());
     let name = maps_dir
         .file_name()
         .map_or("map".to_string(), |n| n.to_string_lossy().into_owned());
@@ -348,7 +329,7 @@ pub fn bench_map_files(
     for (index, pair) in pairs.iter().enumerate() {
         let path = maps_dir.join(format!("{}__{}.txt", pair.source, pair.target));
         let map = read_map(&path)?;
-        let scores = score_maps(&mut cache, pair, &[(name.clone(), map, 0.0)], samples)?;
+        let scores = score_maps(&mut store, pair, &[(name.clone(), map, 0.0)], samples)?;
         let outcome = PairScores {
             source: pair.source.clone(),
             target: pair.target.clone(),
@@ -361,12 +342,12 @@ pub fn bench_map_files(
     Ok(results)
 }
 
-/// The layout and the (first `limit`) pairs of a pair list.
-fn pair_list(pairs_file: &Path, limit: Option<usize>) -> Result<(Layout, Vec<Pair>)> {
-    let layout = Layout::from_pairs_file(pairs_file)?;
+/// The dataset and the (first `limit`) pairs of a pair list.
+fn pair_list(root: &Path, pairs_file: &Path, limit: Option<usize>) -> Result<(Dataset, Vec<Pair>)> {
+    let dataset = Dataset::for_pairs_file(root, pairs_file)?;
     let mut pairs = read_pairs(pairs_file)?;
     pairs.truncate(limit.unwrap_or(usize::MAX));
-    Ok((layout, pairs))
+    Ok((dataset, pairs))
 }
 
 /// Reads a map file: one 0-based vertex index per line.
@@ -437,22 +418,26 @@ pub fn pointwise_table(results: &[PairScores]) -> String {
 }
 
 /// Cumulative error curves over all pairs (flip allowed where a mirror map exists): one
-/// column per method, thresholds 0 to 0.25, as CSV text.
-pub fn curves_csv(
-    results: &[PairScores],
-    thresholds: &[f64],
-) -> (Vec<String>, Vec<Vec<f64>>, String) {
+/// column per method at [`curve_thresholds`] (0 to 0.25), every scored ground-truth pair
+/// weighted alike. Returns the methods, their curves and the CSV text.
+pub fn curves_csv(results: &[PairScores]) -> (Vec<String>, Vec<Vec<f64>>, String) {
+    let thresholds = curve_thresholds();
     let methods: Vec<String> = results
         .first()
         .map(|r| r.scores.iter().map(|s| s.method.clone()).collect())
         .unwrap_or_default();
     let curves: Vec<Vec<f64>> = (0..methods.len())
         .map(|m| {
-            let errors: Vec<f64> = results
-                .iter()
-                .flat_map(|r| r.scores[m].best_errors.iter().copied())
-                .collect();
-            crate::evaluation::error_curve(&errors, thresholds)
+            let total: usize = results.iter().map(|r| r.scores[m].n_scored).sum();
+            (0..thresholds.len())
+                .map(|i| {
+                    let within: f64 = results
+                        .iter()
+                        .map(|r| r.scores[m].curve[i] * r.scores[m].n_scored as f64)
+                        .sum();
+                    within / total.max(1) as f64
+                })
+                .collect()
         })
         .collect();
     let mut csv = format!("threshold,{}\n", methods.join(","));
@@ -464,4 +449,37 @@ pub fn curves_csv(
         csv.push('\n');
     }
     (methods, curves, csv)
+}
+
+/// Writes the cumulative error curves of `results` as CSV to `csv_path` and as a PNG beside
+/// it (same name, `.png`), titled with `name`. Returns whether a font was found for the
+/// PNG's text.
+pub fn write_curves(csv_path: &Path, name: &str, results: &[PairScores]) -> Result<bool> {
+    let (methods, curves, csv) = curves_csv(results);
+    std::fs::write(csv_path, csv).map_err(|e| Error::file(csv_path, e.to_string()))?;
+    let thresholds = curve_thresholds();
+    let series: Vec<crate::plot::Series> = methods
+        .iter()
+        .zip(&curves)
+        .map(|(m, c)| crate::plot::Series {
+            label: m.clone(),
+            points: thresholds.iter().copied().zip(c.iter().copied()).collect(),
+        })
+        .collect();
+    let title = format!(
+        "{name} ({} pairs): fraction of vertices within a geodesic error",
+        results.len()
+    );
+    let rendered = crate::plot::line_chart_png(
+        &csv_path.with_extension("png"),
+        &crate::plot::Chart {
+            title: &title,
+            x_label: "geodesic error / sqrt(area) (flip allowed where a mirror map exists)",
+            y_label: "fraction of vertices",
+            x_range: (0.0, 0.25),
+            y_range: (0.0, 1.0),
+        },
+        &series,
+    )?;
+    Ok(rendered.font.is_some())
 }

@@ -100,7 +100,7 @@ impl Params {
 }
 
 /// Seconds spent in each stage.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Timings {
     pub eigenbasis_a: f64,
     pub eigenbasis_b: f64,

@@ -1,14 +1,30 @@
-//! Benchmark datasets on disk: pair lists and ground truth, in the layouts of
-//! `shared/data/README.md` (FAUST registrations, TOSCA, remeshed TOSCA with `.vts` files).
+//! Benchmark datasets on disk: one registry for the standard layouts (`shared/data/README.md`),
+//! their pair lists and their ground truth.
+//!
 //! The data is research-only and never part of the repository: a root folder is given on
-//! the command line or by `SHAPECORR_DATA`.
+//! the command line or by `SHAPECORR_DATA`. Under it, dataset `NAME` lives in `NAME/` and its
+//! pair list in `pairs/NAME.txt` (tab separated: source, target, category). The layout of a
+//! dataset follows its name when the name is a known one ([`Layout::for_name`]), else its
+//! folder's contents ([`Layout::detect`]):
+//!
+//! | layout | shapes | ground truth | mirror map (flip-tolerant scores) |
+//! |---|---|---|---|
+//! | [`Layout::SharedOrder`] (FAUST `tr_reg_XXX`, SCAPE `meshXXX`) | `NAME/X.{ply,off,obj}` | identity by vertex index | `NAME/template_mirror.txt` |
+//! | [`Layout::SharedOrderPerClass`] (TOSCA `cat0`, `david13`) | `NAME/X.{ply,off,obj}` | identity within a class (name without trailing digits) | `NAME/CLASS_mirror.txt` |
+//! | [`Layout::Vts`] (FAUST_r, SCAPE_r, TOSCA_r) | `NAME/off/X.off` or `NAME/shapes/X.*` | `NAME/corres/X.vts`: row k of A's file matches row k of B's (1-based) | `NAME/corres/X.sym.vts` |
+//! | [`Layout::TemplateIndex`] (remeshed shapes) | `NAME/shapes/X.*` | `NAME/template/X.txt`: the 0-based template vertex of every vertex | `NAME/template_mirror.txt` on the template |
+//!
+//! Mirror maps give, per vertex (of the template), the vertex at the mirrored position. Every
+//! missing or malformed file is an [`Error::File`] naming the path and what was expected.
 
 use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
 
 /// One line of a pair list: source, target, category.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Pair {
     pub source: String,
     pub target: String,
@@ -46,53 +62,175 @@ pub fn read_pairs(path: &Path) -> Result<Vec<Pair>> {
 /// Ground-truth vertex pairs `(vertex of source, vertex of target)`.
 pub type VertexPairs = Vec<(u32, u32)>;
 
-/// How a dataset stores shapes and ground truth.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// How a dataset stores shapes and ground truth (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Layout {
-    /// `faust/NAME.ply`, one shared vertex order, mirror map `faust/template_mirror.txt`.
-    Faust,
-    /// `tosca/NAME.ply`, shared vertex order within a class, mirror `tosca/CLASS_mirror.txt`.
-    Tosca,
-    /// `tosca_r/off/NAME.off` with `tosca_r/corres/NAME.vts` and `NAME.sym.vts`.
-    ToscaRemeshed,
+    /// Every shape has the same vertex order (FAUST registrations, SCAPE).
+    SharedOrder,
+    /// Shapes of a class share a vertex order (TOSCA).
+    SharedOrderPerClass,
+    /// Independently remeshed shapes with `.vts` correspondence files.
+    Vts,
+    /// Independently remeshed shapes with a per-vertex template index.
+    TemplateIndex,
 }
 
 impl Layout {
-    /// The layout a pair list belongs to, from its file name (`faust.txt`, `tosca.txt`,
-    /// `tosca_r.txt`).
-    pub fn from_pairs_file(path: &Path) -> Result<Layout> {
-        match path.file_stem().and_then(|s| s.to_str()) {
-            Some("faust") => Ok(Layout::Faust),
-            Some("tosca") => Ok(Layout::Tosca),
-            Some("tosca_r") => Ok(Layout::ToscaRemeshed),
-            _ => Err(Error::file(
-                path,
-                "unknown pair list: name it faust.txt, tosca.txt or tosca_r.txt (the layout follows the name)",
-            )),
+    /// The layout of a dataset with a known name: `faust`, `scape` share one vertex order,
+    /// `tosca` per class, `*_r` (`faust_r`, `scape_r`, `tosca_r`, `shrec19_r`, ...) use `.vts`.
+    pub fn for_name(name: &str) -> Option<Layout> {
+        match name {
+            "faust" | "scape" => Some(Layout::SharedOrder),
+            "tosca" => Some(Layout::SharedOrderPerClass),
+            n if n.ends_with("_r") => Some(Layout::Vts),
+            _ => None,
         }
     }
 
-    /// The shape file of `name` under `root`.
-    pub fn shape_path(&self, root: &Path, name: &str) -> PathBuf {
-        match self {
-            Layout::Faust => root.join("faust").join(format!("{name}.ply")),
-            Layout::Tosca => root.join("tosca").join(format!("{name}.ply")),
-            Layout::ToscaRemeshed => root.join("tosca_r").join("off").join(format!("{name}.off")),
+    /// The layout of a dataset folder from its contents: `corres/` holds `.vts` files,
+    /// `template/` template indices, files `*_mirror.txt` other than `template_mirror.txt`
+    /// mean per-class mirror maps (TOSCA), anything else with shapes one shared order.
+    pub fn detect(folder: &Path) -> Result<Layout> {
+        if !folder.is_dir() {
+            return Err(Error::file(folder, "dataset folder not found"));
         }
+        if folder.join("corres").is_dir() {
+            return Ok(Layout::Vts);
+        }
+        if folder.join("template").is_dir() {
+            return Ok(Layout::TemplateIndex);
+        }
+        let entries = std::fs::read_dir(folder).map_err(|e| Error::file(folder, e.to_string()))?;
+        let names: Vec<String> = entries
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        if names
+            .iter()
+            .any(|n| n.ends_with("_mirror.txt") && n != "template_mirror.txt")
+        {
+            return Ok(Layout::SharedOrderPerClass);
+        }
+        if names.iter().any(|n| shape_extension(n)) {
+            return Ok(Layout::SharedOrder);
+        }
+        Err(Error::file(
+            folder,
+            "cannot tell the dataset's layout: no corres/ (.vts), no template/ and no shape files (.ply, .off, .obj)",
+        ))
+    }
+}
+
+fn shape_extension(file_name: &str) -> bool {
+    [".ply", ".off", ".obj"]
+        .iter()
+        .any(|e| file_name.to_ascii_lowercase().ends_with(e))
+}
+
+/// A dataset: its name, folder and layout.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Dataset {
+    pub name: String,
+    /// `root/name`.
+    pub folder: PathBuf,
+    pub layout: Layout,
+}
+
+impl Dataset {
+    /// Dataset `name` under `root` (`root/name/`), its layout from its name or contents.
+    pub fn open(root: &Path, name: &str) -> Result<Dataset> {
+        let folder = root.join(name);
+        if !folder.is_dir() {
+            return Err(Error::file(
+                &folder,
+                format!(
+                    "dataset folder not found (give the data root with --data or SHAPECORR_DATA; looked under {})",
+                    root.display()
+                ),
+            ));
+        }
+        let layout = match Layout::for_name(name) {
+            Some(layout) => layout,
+            None => Layout::detect(&folder)?,
+        };
+        Ok(Dataset {
+            name: name.to_string(),
+            folder,
+            layout,
+        })
+    }
+
+    /// The dataset a pair list belongs to: `pairs/NAME.txt` belongs to `NAME` under `root`.
+    pub fn for_pairs_file(root: &Path, pairs_file: &Path) -> Result<Dataset> {
+        let name = pairs_file
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .ok_or_else(|| Error::file(pairs_file, "a pair list is named NAME.txt"))?;
+        Dataset::open(root, name)
+    }
+
+    /// The pair list `root/pairs/NAME.txt`.
+    pub fn pairs_file(&self, root: &Path) -> PathBuf {
+        root.join("pairs").join(format!("{}.txt", self.name))
+    }
+
+    /// The shape file of `name`: the first of `NAME.ply`, `.off`, `.obj` found in the
+    /// dataset folder (or its `off/` and `shapes/` subfolders for remeshed layouts).
+    pub fn shape_path(&self, name: &str) -> Result<PathBuf> {
+        let folders: Vec<PathBuf> = match self.layout {
+            Layout::SharedOrder | Layout::SharedOrderPerClass => vec![self.folder.clone()],
+            Layout::Vts | Layout::TemplateIndex => vec![
+                self.folder.join("off"),
+                self.folder.join("shapes"),
+                self.folder.clone(),
+            ],
+        };
+        let candidates: Vec<PathBuf> = folders
+            .iter()
+            .flat_map(|f| ["ply", "off", "obj"].map(|e| f.join(format!("{name}.{e}"))))
+            .collect();
+        candidates
+            .iter()
+            .find(|p| p.is_file())
+            .cloned()
+            .ok_or_else(|| {
+                Error::file(
+                    &candidates[0],
+                    format!(
+                        "shape {name:?} of dataset {} not found (tried .ply, .off and .obj in {})",
+                        self.name,
+                        folders
+                            .iter()
+                            .map(|f| f.display().to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                )
+            })
     }
 
     /// Ground-truth vertex pairs `(vertex of source, vertex of target)`, and the same with
     /// the target mirrored (for flip-tolerant scores) when a mirror map exists.
     pub fn ground_truth(
         &self,
-        root: &Path,
         source: &str,
         target: &str,
         n_source: usize,
         n_target: usize,
     ) -> Result<(VertexPairs, Option<VertexPairs>)> {
-        match self {
-            Layout::Faust | Layout::Tosca => {
+        match self.layout {
+            Layout::SharedOrder | Layout::SharedOrderPerClass => {
+                if self.layout == Layout::SharedOrderPerClass
+                    && class_of(source) != class_of(target)
+                {
+                    return Err(Error::InvalidParameter {
+                        name: "pair",
+                        reason: format!(
+                            "{source} and {target} are of different classes of {}: no ground truth",
+                            self.name
+                        ),
+                    });
+                }
                 if n_source != n_target {
                     return Err(Error::InvalidParameter {
                         name: "pair",
@@ -102,44 +240,91 @@ impl Layout {
                     });
                 }
                 let identity: Vec<(u32, u32)> = (0..n_source as u32).map(|v| (v, v)).collect();
-                let mirror_path = match self {
-                    Layout::Faust => root.join("faust").join("template_mirror.txt"),
-                    _ => root
-                        .join("tosca")
-                        .join(format!("{}_mirror.txt", class_of(target))),
-                };
-                let flipped = if mirror_path.exists() {
-                    let mirror = read_indices(&mirror_path, 0)?;
-                    check_range(&mirror_path, &mirror, n_target)?;
-                    if mirror.len() != n_target {
-                        return Err(Error::file(
-                            &mirror_path,
-                            format!("{} entries for {n_target} vertices", mirror.len()),
-                        ));
-                    }
-                    Some(
-                        identity
-                            .iter()
-                            .map(|&(x, y)| (x, mirror[y as usize]))
-                            .collect(),
-                    )
-                } else {
-                    None
-                };
+                let flipped = self.mirror_map(target, n_target)?.map(|mirror| {
+                    identity
+                        .iter()
+                        .map(|&(x, y)| (x, mirror[y as usize]))
+                        .collect()
+                });
                 Ok((identity, flipped))
             }
-            Layout::ToscaRemeshed => {
-                let corres = root.join("tosca_r").join("corres");
+            Layout::Vts => {
+                let corres = self.folder.join("corres");
                 let a = read_indices(&corres.join(format!("{source}.vts")), 1)?;
                 let b = read_indices(&corres.join(format!("{target}.vts")), 1)?;
                 check_range(&corres.join(format!("{source}.vts")), &a, n_source)?;
                 check_range(&corres.join(format!("{target}.vts")), &b, n_target)?;
+                if a.len() != b.len() {
+                    return Err(Error::file(
+                        corres.join(format!("{target}.vts")),
+                        format!(
+                            "{} rows, but {source}.vts has {}: row k of one must match row k of the other",
+                            b.len(),
+                            a.len()
+                        ),
+                    ));
+                }
                 let truth: Vec<(u32, u32)> = a.iter().copied().zip(b.iter().copied()).collect();
                 let sym_path = corres.join(format!("{target}.sym.vts"));
                 let flipped = if sym_path.exists() {
                     let b_sym = read_indices(&sym_path, 1)?;
                     check_range(&sym_path, &b_sym, n_target)?;
+                    if b_sym.len() != a.len() {
+                        return Err(Error::file(
+                            &sym_path,
+                            format!("{} rows, expected {}", b_sym.len(), a.len()),
+                        ));
+                    }
                     Some(a.iter().copied().zip(b_sym).collect())
+                } else {
+                    None
+                };
+                Ok((truth, flipped))
+            }
+            Layout::TemplateIndex => {
+                let template = self.folder.join("template");
+                let read = |name: &str, n: usize| -> Result<Vec<u32>> {
+                    let path = template.join(format!("{name}.txt"));
+                    let t = read_indices(&path, 0)?;
+                    if t.len() != n {
+                        return Err(Error::file(
+                            &path,
+                            format!("{} entries for a shape with {n} vertices", t.len()),
+                        ));
+                    }
+                    Ok(t)
+                };
+                let (t_a, t_b) = (read(source, n_source)?, read(target, n_target)?);
+                let n_template = t_a.iter().chain(&t_b).map(|&t| t as usize + 1).max();
+                let n_template = n_template.unwrap_or(0);
+                // The first vertex of A standing for each template vertex.
+                let mut a_of_template = vec![u32::MAX; n_template];
+                for (x, &t) in t_a.iter().enumerate().rev() {
+                    a_of_template[t as usize] = x as u32;
+                }
+                let pairs_with = |map_b: &dyn Fn(u32) -> u32| -> VertexPairs {
+                    t_b.iter()
+                        .enumerate()
+                        .filter_map(|(y, &t)| {
+                            let x = *a_of_template.get(map_b(t) as usize)?;
+                            (x != u32::MAX).then_some((x, y as u32))
+                        })
+                        .collect()
+                };
+                let truth = pairs_with(&|t| t);
+                if truth.is_empty() {
+                    return Err(Error::InvalidParameter {
+                        name: "pair",
+                        reason: format!("{source} and {target} share no template vertex"),
+                    });
+                }
+                let mirror_path = self.folder.join("template_mirror.txt");
+                let flipped = if mirror_path.exists() {
+                    let mirror = read_indices(&mirror_path, 0)?;
+                    check_range(&mirror_path, &mirror, mirror.len())?;
+                    Some(pairs_with(&|t| {
+                        mirror.get(t as usize).copied().unwrap_or(u32::MAX)
+                    }))
                 } else {
                     None
                 };
@@ -147,6 +332,58 @@ impl Layout {
             }
         }
     }
+
+    /// The mirror map of a shared-order dataset (per class for TOSCA), checked against the
+    /// number of vertices; None when the dataset has none.
+    fn mirror_map(&self, target: &str, n_target: usize) -> Result<Option<Vec<u32>>> {
+        let path = match self.layout {
+            Layout::SharedOrderPerClass => {
+                self.folder.join(format!("{}_mirror.txt", class_of(target)))
+            }
+            _ => self.folder.join("template_mirror.txt"),
+        };
+        if !path.exists() {
+            return Ok(None);
+        }
+        let mirror = read_indices(&path, 0)?;
+        check_range(&path, &mirror, n_target)?;
+        if mirror.len() != n_target {
+            return Err(Error::file(
+                &path,
+                format!("{} entries for {n_target} vertices", mirror.len()),
+            ));
+        }
+        Ok(Some(mirror))
+    }
+}
+
+/// The datasets under `root` that have both a folder and a pair list `pairs/NAME.txt`,
+/// sorted by name. Folders without a pair list (and pair lists without a folder) are
+/// skipped: they are listed in the second value with the reason.
+pub fn discover(root: &Path) -> Result<(Vec<Dataset>, Vec<String>)> {
+    let pairs_dir = root.join("pairs");
+    let entries = std::fs::read_dir(&pairs_dir).map_err(|e| {
+        Error::file(
+            &pairs_dir,
+            format!("{e} (the data root needs a pairs/ folder of NAME.txt pair lists)"),
+        )
+    })?;
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.strip_suffix(".txt").map(str::to_string)
+        })
+        .collect();
+    names.sort();
+    let (mut found, mut skipped) = (Vec::new(), Vec::new());
+    for name in names {
+        match Dataset::open(root, &name) {
+            Ok(d) => found.push(d),
+            Err(e) => skipped.push(format!("{name}: {e}")),
+        }
+    }
+    Ok((found, skipped))
 }
 
 /// The class of a TOSCA shape name: the name without its trailing digits.

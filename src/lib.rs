@@ -35,7 +35,10 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bench;
+pub mod bench_all;
+pub mod bench_clouds;
 pub mod bench_pointwise;
+pub mod bench_store;
 pub mod correspondence;
 pub mod datasets;
 pub mod descriptors;
@@ -54,6 +57,7 @@ pub mod options;
 pub mod plot;
 pub mod pointwise;
 pub mod progress;
+pub mod reeb;
 pub mod segmentation;
 pub mod shape;
 mod sparse;

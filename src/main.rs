@@ -161,7 +161,8 @@ enum BenchCommand {
         /// Dataset root (default: $SHAPECORR_DATA or ../shared/data).
         #[arg(long)]
         data: Option<PathBuf>,
-        /// Pair list (faust.txt, tosca.txt or tosca_r.txt; the layout follows the name).
+        /// Pair list DATA/pairs/NAME.txt of the dataset in DATA/NAME (its layout from the
+        /// name or the folder's contents: see src/datasets.rs).
         #[arg(long)]
         pairs: PathBuf,
         /// Only the first N pairs.
@@ -176,7 +177,8 @@ enum BenchCommand {
         /// Dataset root (default: $SHAPECORR_DATA or ../shared/data).
         #[arg(long)]
         data: Option<PathBuf>,
-        /// Pair list (faust.txt, tosca.txt or tosca_r.txt; the layout follows the name).
+        /// Pair list DATA/pairs/NAME.txt of the dataset in DATA/NAME (its layout from the
+        /// name or the folder's contents: see src/datasets.rs).
         #[arg(long)]
         pairs: PathBuf,
         /// Only the first N pairs.
@@ -198,6 +200,43 @@ enum BenchCommand {
         method: MethodArgs,
         #[command(flatten)]
         pointwise: PointwiseArgs,
+    },
+    /// The paper's whole evaluation on every dataset found under the data root (a dataset
+    /// NAME = a folder NAME/ and a pair list pairs/NAME.txt): region accuracy with the Reeb
+    /// baseline, point-to-point errors and curves, the point-cloud protocol, timing. Writes
+    /// OUT/results.md and OUT/images/. Resumable: finished results are kept in WORK/logs and
+    /// eigenbases in WORK/eigenbases.
+    All {
+        /// Dataset root (default: $SHAPECORR_DATA or ../shared/data; quick mode: WORK/data).
+        #[arg(long)]
+        data: Option<PathBuf>,
+        /// Where results.md and images/ go (default: docs; quick mode: WORK).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Logs and eigenbasis cache (default: target/bench-all; quick mode: target/bench-quick).
+        #[arg(long)]
+        work: Option<PathBuf>,
+        /// Generated shapes only, small protocol (what CI runs).
+        #[arg(long)]
+        quick: bool,
+        /// Only these datasets (comma separated).
+        #[arg(long, value_delimiter = ',')]
+        datasets: Option<Vec<String>>,
+        /// At most N pairs per dataset, spread over its pair list.
+        #[arg(long)]
+        limit: Option<usize>,
+        /// Ground-truth pairs scored per shape pair for the pointwise errors (0 = all).
+        #[arg(long, default_value_t = 1000)]
+        samples: usize,
+        /// Pairs of the point-cloud protocol (default 6; quick 2).
+        #[arg(long)]
+        cloud_pairs: Option<usize>,
+        /// Pairs per dataset of the timing table (default 4; quick 2).
+        #[arg(long)]
+        timing_pairs: Option<usize>,
+        /// Forget the logs of earlier runs (the eigenbasis cache is kept).
+        #[arg(long)]
+        fresh: bool,
     },
     /// Scores maps computed elsewhere, stored as MAPS/{source}__{target}.txt (for every
     /// vertex of the target, the 0-based index of its vertex on the source), with the same
@@ -485,6 +524,54 @@ fn main() -> ExitCode {
                     json,
                 },
         } => bench_maps_command(data, &pairs, &maps, limit, samples, json.as_deref()),
+        Command::Bench {
+            which:
+                BenchCommand::All {
+                    data,
+                    out,
+                    work,
+                    quick,
+                    datasets,
+                    limit,
+                    samples,
+                    cloud_pairs,
+                    timing_pairs,
+                    fresh,
+                },
+        } => {
+            let work = work.unwrap_or_else(|| {
+                PathBuf::from(if quick {
+                    "target/bench-quick"
+                } else {
+                    "target/bench-all"
+                })
+            });
+            let data = data.unwrap_or_else(|| {
+                if quick {
+                    work.join("data")
+                } else {
+                    shapecorr::datasets::default_data_root()
+                }
+            });
+            let out = out.unwrap_or_else(|| {
+                if quick {
+                    work.clone()
+                } else {
+                    PathBuf::from("docs")
+                }
+            });
+            let mut p = shapecorr::bench_all::AllParams::new(data, out, work, quick);
+            p.datasets = datasets;
+            p.limit = limit;
+            p.p2p_samples = samples;
+            p.cloud_pairs = cloud_pairs.unwrap_or(p.cloud_pairs);
+            p.timing_pairs = timing_pairs.unwrap_or(p.timing_pairs);
+            p.command = std::iter::once("shapecorr".to_string())
+                .chain(std::env::args().skip(1))
+                .collect::<Vec<_>>()
+                .join(" ");
+            bench_all_command(&p, fresh)
+        }
         Command::Demo { out, vertices } => demo(&out, vertices),
     };
     match result {
@@ -1013,43 +1100,32 @@ fn bench_p2p_command(
         write_scores_json(path, &results)?;
     }
     if let Some(path) = curves {
-        let thresholds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.0025).collect();
-        let (methods, curves, csv) = shapecorr::bench_pointwise::curves_csv(&results, &thresholds);
-        std::fs::write(path, csv).map_err(|e| Error::file(path, e.to_string()))?;
-        let series: Vec<shapecorr::plot::Series> = methods
-            .iter()
-            .zip(&curves)
-            .map(|(m, c)| shapecorr::plot::Series {
-                label: m.clone(),
-                points: thresholds.iter().copied().zip(c.iter().copied()).collect(),
-            })
-            .collect();
-        let title = format!(
-            "{} ({} pairs): fraction of vertices within a geodesic error",
-            pairs
-                .file_stem()
-                .map_or(String::new(), |s| s.to_string_lossy().into_owned()),
-            results.len()
-        );
-        let png = path.with_extension("png");
-        let rendered = shapecorr::plot::line_chart_png(
-            &png,
-            &shapecorr::plot::Chart {
-                title: &title,
-                x_label: "geodesic error / sqrt(area) (flip allowed where a mirror map exists)",
-                y_label: "fraction of vertices",
-                x_range: (0.0, 0.25),
-                y_range: (0.0, 1.0),
-            },
-            &series,
-        )?;
-        if rendered.font.is_none() {
+        let name = pairs
+            .file_stem()
+            .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+        if !shapecorr::bench_pointwise::write_curves(path, &name, &results)? {
             eprintln!(
                 "shapecorr: no font found, {} has no text (set SHAPECORR_FONT)",
-                png.display()
+                path.with_extension("png").display()
             );
         }
     }
+    Ok(())
+}
+
+fn bench_all_command(p: &shapecorr::bench_all::AllParams, fresh: bool) -> Result<(), Error> {
+    let logs = p.work.join("logs");
+    if fresh && logs.exists() {
+        std::fs::remove_dir_all(&logs).map_err(|e| Error::file(&logs, e.to_string()))?;
+    }
+    let started = Instant::now();
+    let page = shapecorr::bench_all::run_all(p)?;
+    println!(
+        "{} written ({:.0} s); logs and eigenbasis cache in {}",
+        page.display(),
+        started.elapsed().as_secs_f64(),
+        p.work.display()
+    );
     Ok(())
 }
 

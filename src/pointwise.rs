@@ -153,7 +153,7 @@ impl PointwiseParams {
 }
 
 /// Seconds per stage of the pointwise map.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PointwiseTimings {
     /// Descriptors and the first functional map.
     pub fmap: f64,

@@ -1843,7 +1843,12 @@ fn validate_inputs(
 }
 
 /// Degree histograms, connectivity and sizes of two graphs.
-fn compare_graphs(k: usize, a: &ShapeGraph, b: &ShapeGraph, max_regions: usize) -> KCandidate {
+pub(crate) fn compare_graphs(
+    k: usize,
+    a: &ShapeGraph,
+    b: &ShapeGraph,
+    max_regions: usize,
+) -> KCandidate {
     let (connected_a, connected_b) = (a.is_connected(), b.is_connected());
     let (n_nodes_a, n_nodes_b) = (a.n_nodes(), b.n_nodes());
     KCandidate {

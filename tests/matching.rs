@@ -631,7 +631,7 @@ fn measure_variants() {
 #[test]
 #[ignore = "measurement on benchmark data; run with --ignored --nocapture"]
 fn measure_variants_on_benchmark_pairs() {
-    use shapecorr::datasets::{default_data_root, read_pairs, Layout};
+    use shapecorr::datasets::{default_data_root, read_pairs, Dataset};
     use shapecorr::evaluation::score as region_scores;
     use shapecorr::geodesic::region_distance_matrix;
     use shapecorr::matching::match_hop_distances;
@@ -648,7 +648,7 @@ fn measure_variants_on_benchmark_pairs() {
         return;
     }
     let pairs = read_pairs(&list).unwrap();
-    let layout = Layout::from_pairs_file(&list).unwrap();
+    let dataset = Dataset::for_pairs_file(&root, &list).unwrap();
     let wanted: usize = std::env::var("MATCHING_PAIRS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -683,7 +683,7 @@ fn measure_variants_on_benchmark_pairs() {
         cache
             .entry(name.to_string())
             .or_insert_with(|| {
-                let shape = Shape::read(&layout.shape_path(&root, name), false).unwrap();
+                let shape = Shape::read(&dataset.shape_path(name).unwrap(), false).unwrap();
                 let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
                 let hks = hks(&basis, &HksParams::default()).unwrap();
                 std::rc::Rc::new(Prepared {
@@ -728,9 +728,8 @@ fn measure_variants_on_benchmark_pairs() {
             nb,
             1.0 / b.shape.mesh_area().sqrt(),
         );
-        let (truth, flipped) = layout
+        let (truth, flipped) = dataset
             .ground_truth(
-                &root,
                 &pair.source,
                 &pair.target,
                 a.shape.n_vertices(),
