@@ -112,14 +112,7 @@ impl CloudProtocol {
 /// Width of a shape for the noise bound: the largest extent of its axis-aligned bounding box
 /// (a standing body's height). Smaller than [`Shape::width`], the box's diagonal.
 pub fn largest_extent(points: &[[f64; 3]]) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = crate::shape::bounding_box(points);
     (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
 }
 

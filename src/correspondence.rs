@@ -208,30 +208,12 @@ impl Correspondence {
 
         check(progress, Stage::SymmetryBreaking, 0.0)?;
         let t = Instant::now();
-        let matches_one_to_one = if params.skip_one_to_one {
-            Vec::new()
-        } else {
-            let d_a = region_distance_matrix(
-                a,
-                &basis_a.mass,
-                &segmentation.graph_a.labels,
-                segmentation.graph_a.n_nodes(),
-                1.0 / basis_a.input_area.sqrt(),
-            );
-            let d_b = region_distance_matrix(
-                b,
-                &basis_b.mass,
-                &segmentation.graph_b.labels,
-                segmentation.graph_b.n_nodes(),
-                1.0 / basis_b.input_area.sqrt(),
-            );
-            one_to_one(
-                &matching.matches,
-                d_a.as_ref(),
-                d_b.as_ref(),
-                &params.symmetry,
-            )?
-        };
+        let matches_one_to_one = one_to_one_matches(
+            (a, basis_a, &segmentation.graph_a),
+            (b, basis_b, &segmentation.graph_b),
+            &matching.matches,
+            params,
+        )?;
         timings.one_to_one = t.elapsed().as_secs_f64();
         check(progress, Stage::SymmetryBreaking, 1.0)?;
         timings.total = started.elapsed().as_secs_f64();
@@ -483,6 +465,35 @@ impl Symmetry {
             .map(|&r| region_colour[r as usize])
             .collect()
     }
+}
+
+/// The one-to-one step (paper section 5.2) on symmetric `matches` between the regions of
+/// `graph_a` and `graph_b`: region-to-region distances on each shape, then
+/// [`one_to_one`]; empty when `params.skip_one_to_one`. Shared by the main method and the
+/// Reeb baseline ([`crate::reeb`]).
+pub(crate) fn one_to_one_matches(
+    (a, basis_a, graph_a): (&Shape, &Eigenbasis, &ShapeGraph),
+    (b, basis_b, graph_b): (&Shape, &Eigenbasis, &ShapeGraph),
+    matches: &[(u32, u32)],
+    params: &Params,
+) -> Result<Vec<(u32, u32)>> {
+    if params.skip_one_to_one {
+        return Ok(Vec::new());
+    }
+    let distances = |shape: &Shape, basis: &Eigenbasis, graph: &ShapeGraph| {
+        region_distance_matrix(
+            shape,
+            &basis.mass,
+            &graph.labels,
+            graph.n_nodes(),
+            1.0 / basis.input_area.sqrt(),
+        )
+    };
+    let (d_a, d_b) = (
+        distances(a, basis_a, graph_a),
+        distances(b, basis_b, graph_b),
+    );
+    one_to_one(matches, d_a.as_ref(), d_b.as_ref(), &params.symmetry)
 }
 
 /// Convenience: [`Correspondence::compute`] with default parameters and no progress.

@@ -33,15 +33,13 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use crate::correspondence::{Correspondence, Params, Timings};
+use crate::correspondence::{one_to_one_matches, Correspondence, Params, Timings};
 use crate::descriptors::{hks, HksParams};
 use crate::eigen::Eigenbasis;
-use crate::geodesic::region_distance_matrix;
 use crate::graph::ShapeGraph;
 use crate::matching::match_graphs;
-use crate::segmentation::compare_graphs;
+use crate::segmentation::{compare_graphs, Regions};
 use crate::shape::{DisjointSets, Shape};
-use crate::symmetry::one_to_one;
 use crate::{Error, Result};
 
 /// HKS time of the baseline on the unit-area shape (the crate's HKS convention: absolute
@@ -280,14 +278,14 @@ pub fn reeb_graph(
             sets.union(u as usize, v as usize);
         }
     }
-    let mut parts = Parts::default();
+    let mut parts = Regions::default();
     let mut part_of = vec![u32::MAX; n];
     let mut part_of_root: BTreeMap<usize, u32> = BTreeMap::new();
     for &v in active {
-        let next = parts.level.len() as u32;
+        let next = parts.cluster.len() as u32;
         let p = *part_of_root.entry(sets.find(v as usize)).or_insert(next);
         if p == next {
-            parts.level.push(level[v as usize]);
+            parts.cluster.push(level[v as usize]);
             parts.area.push(0.0);
             parts.first_vertex.push(v);
             parts.neighbours.push(BTreeMap::new());
@@ -308,15 +306,15 @@ pub fn reeb_graph(
     }
 
     // Nodes: surviving parts numbered by smallest vertex.
-    let mut survivors: Vec<u32> = (0..parts.level.len() as u32)
+    let mut survivors: Vec<u32> = (0..parts.cluster.len() as u32)
         .filter(|&p| parts.absorbed_into[p as usize] == u32::MAX)
         .collect();
     survivors.sort_by_key(|&p| parts.first_vertex[p as usize]);
-    let mut node_of_part = vec![u32::MAX; parts.level.len()];
+    let mut node_of_part = vec![u32::MAX; parts.cluster.len()];
     for (node, &p) in survivors.iter().enumerate() {
         node_of_part[p as usize] = node as u32;
     }
-    for p in 0..parts.level.len() {
+    for p in 0..parts.cluster.len() {
         node_of_part[p] = node_of_part[parts.resolve(p as u32) as usize];
     }
     let n_nodes = survivors.len();
@@ -349,7 +347,10 @@ pub fn reeb_graph(
     }
     Ok(ShapeGraph {
         labels,
-        node_cluster: survivors.iter().map(|&p| parts.level[p as usize]).collect(),
+        node_cluster: survivors
+            .iter()
+            .map(|&p| parts.cluster[p as usize])
+            .collect(),
         node_area,
         node_descriptor,
         edges: graph_edges,
@@ -444,30 +445,12 @@ pub fn reeb_correspondence(
     timings.matching = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let matches_one_to_one = if params.skip_one_to_one {
-        Vec::new()
-    } else {
-        let d_a = region_distance_matrix(
-            a,
-            &basis_a.mass,
-            &graph_a.labels,
-            graph_a.n_nodes(),
-            1.0 / basis_a.input_area.sqrt(),
-        );
-        let d_b = region_distance_matrix(
-            b,
-            &basis_b.mass,
-            &graph_b.labels,
-            graph_b.n_nodes(),
-            1.0 / basis_b.input_area.sqrt(),
-        );
-        one_to_one(
-            &matching.matches,
-            d_a.as_ref(),
-            d_b.as_ref(),
-            &params.symmetry,
-        )?
-    };
+    let matches_one_to_one = one_to_one_matches(
+        (a, basis_a, &graph_a),
+        (b, basis_b, &graph_b),
+        &matching.matches,
+        params,
+    )?;
     timings.one_to_one = t.elapsed().as_secs_f64();
     timings.total = started.elapsed().as_secs_f64();
 
@@ -486,79 +469,4 @@ pub fn reeb_correspondence(
         candidates: vec![candidate],
         timings,
     })
-}
-
-/// Connected components of the level intervals while fragments are merged.
-#[derive(Default)]
-struct Parts {
-    level: Vec<u32>,
-    area: Vec<f64>,
-    first_vertex: Vec<u32>,
-    /// Neighbouring parts and the number of vertex edges shared with each.
-    neighbours: Vec<BTreeMap<u32, u32>>,
-    /// The part this one was merged into (`u32::MAX`: still a part).
-    absorbed_into: Vec<u32>,
-}
-
-impl Parts {
-    fn resolve(&self, mut p: u32) -> u32 {
-        while self.absorbed_into[p as usize] != u32::MAX {
-            p = self.absorbed_into[p as usize];
-        }
-        p
-    }
-
-    /// Merges parts below `threshold` mass, smallest first, into the neighbour sharing most
-    /// edges (ties: the larger, then the lower numbered); parts of the absorbing level that
-    /// touched the fragment join too (they are now connected within that level). A part
-    /// without neighbours (a separate piece of the shape) stays.
-    fn merge_fragments(&mut self, threshold: f64) {
-        loop {
-            let fragment = (0..self.level.len())
-                .filter(|&p| {
-                    self.absorbed_into[p] == u32::MAX
-                        && self.area[p] < threshold
-                        && !self.neighbours[p].is_empty()
-                })
-                .min_by(|&x, &y| self.area[x].total_cmp(&self.area[y]).then(x.cmp(&y)));
-            let Some(fragment) = fragment else { break };
-            let Some(target) = self.neighbours[fragment]
-                .iter()
-                .max_by(|(&x, &cx), (&y, &cy)| {
-                    cx.cmp(&cy)
-                        .then(self.area[x as usize].total_cmp(&self.area[y as usize]))
-                        .then(y.cmp(&x))
-                })
-                .map(|(&t, _)| t)
-            else {
-                break;
-            };
-            let others: Vec<u32> = self.neighbours[fragment].keys().copied().collect();
-            self.absorb(target, fragment as u32);
-            for other in others {
-                if other != target
-                    && self.absorbed_into[other as usize] == u32::MAX
-                    && self.level[other as usize] == self.level[target as usize]
-                {
-                    self.absorb(target, other);
-                }
-            }
-        }
-    }
-
-    fn absorb(&mut self, target: u32, absorbed: u32) {
-        let (t, a) = (target as usize, absorbed as usize);
-        self.absorbed_into[a] = target;
-        self.area[t] += self.area[a];
-        self.first_vertex[t] = self.first_vertex[t].min(self.first_vertex[a]);
-        let moved = std::mem::take(&mut self.neighbours[a]);
-        for (other, count) in moved {
-            self.neighbours[other as usize].remove(&absorbed);
-            if other != target {
-                *self.neighbours[t].entry(other).or_insert(0) += count;
-                *self.neighbours[other as usize].entry(target).or_insert(0) += count;
-            }
-        }
-        self.neighbours[t].remove(&absorbed);
-    }
 }

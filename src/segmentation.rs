@@ -1549,28 +1549,33 @@ fn first_or_second_edges(
     edges
 }
 
-/// Connected regions while fragments are merged.
+/// Connected regions while fragments are merged (also the Reeb baseline's level components,
+/// [`crate::reeb`]).
 #[derive(Default)]
-struct Regions {
-    cluster: Vec<u32>,
-    area: Vec<f64>,
-    first_vertex: Vec<u32>,
+pub(crate) struct Regions {
+    /// The cluster (Reeb: level interval) of each region.
+    pub(crate) cluster: Vec<u32>,
+    pub(crate) area: Vec<f64>,
+    pub(crate) first_vertex: Vec<u32>,
     /// Neighbouring regions and the number of edges shared with each.
-    neighbours: Vec<BTreeMap<u32, u32>>,
+    pub(crate) neighbours: Vec<BTreeMap<u32, u32>>,
     /// The region this one was merged into (`u32::MAX`: still a region).
-    absorbed_into: Vec<u32>,
+    pub(crate) absorbed_into: Vec<u32>,
 }
 
 impl Regions {
-    fn resolve(&self, mut r: u32) -> u32 {
+    pub(crate) fn resolve(&self, mut r: u32) -> u32 {
         while self.absorbed_into[r as usize] != u32::MAX {
             r = self.absorbed_into[r as usize];
         }
         r
     }
 
-    /// Merges regions below `threshold` area, smallest first, into a neighbour.
-    fn merge_fragments(&mut self, threshold: f64) {
+    /// Merges regions below `threshold` area, smallest first, into the neighbour sharing
+    /// most edges (ties: the larger, then the lower numbered); regions of the absorbing
+    /// cluster that touched the fragment join too. A region without neighbours (a separate
+    /// piece of the shape) stays.
+    pub(crate) fn merge_fragments(&mut self, threshold: f64) {
         loop {
             let fragment = (0..self.cluster.len())
                 .filter(|&r| {

@@ -470,8 +470,8 @@ pub fn triangle_area(vertices: &[[f64; 3]], t: &[u32; 3]) -> f64 {
     0.5 * norm(&cross(&u, &v))
 }
 
-/// Length of the axis-aligned bounding box's diagonal.
-pub fn bounding_box_diagonal(points: &[[f64; 3]]) -> f64 {
+/// Corners `(min, max)` of the axis-aligned bounding box of `points` (infinite for none).
+pub fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points {
@@ -480,9 +480,15 @@ pub fn bounding_box_diagonal(points: &[[f64; 3]]) -> f64 {
             hi[k] = hi[k].max(p[k]);
         }
     }
+    (lo, hi)
+}
+
+/// Length of the axis-aligned bounding box's diagonal (0 for no points).
+pub fn bounding_box_diagonal(points: &[[f64; 3]]) -> f64 {
     if points.is_empty() {
         return 0.0;
     }
+    let (lo, hi) = bounding_box(points);
     distance(&lo, &hi)
 }
 

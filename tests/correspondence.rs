@@ -245,15 +245,21 @@ fn cancelling_stops_the_pipeline_promptly() {
         Stage::Matching,
         Stage::SymmetryBreaking,
     ] {
-        let started = std::time::Instant::now();
-        let mut progress = |stage: Stage, _f: f32| stage != cancel_at;
+        // Promptly = no stage reports progress after the one that was cancelled (a count,
+        // not a wall-clock bound, so a loaded machine cannot fail it).
+        let (mut cancelled, mut calls_after) = (false, 0);
+        let mut progress = |stage: Stage, _f: f32| {
+            calls_after += usize::from(cancelled);
+            cancelled |= stage == cancel_at;
+            stage != cancel_at
+        };
         let result = Correspondence::compute(&a, &b, &Params::default(), &mut progress);
         assert!(
             matches!(result, Err(Error::Cancelled)),
             "{cancel_at:?}: {:?}",
             result.map(|r| r.k)
         );
-        assert!(started.elapsed().as_secs_f64() < 2.0, "{cancel_at:?}");
+        assert_eq!(calls_after, 0, "{cancel_at:?}: progress went on after cancelling");
     }
 }
 

@@ -351,7 +351,6 @@ fn cancelling_from_the_progress_callback_stops_the_eigensolver() {
         }
         calls < 3
     };
-    let started = std::time::Instant::now();
     let result =
         Eigenbasis::compute_with_progress(&shape, &EigenParams::default(), &mut cancel_after_three);
     assert!(
@@ -362,5 +361,4 @@ fn cancelling_from_the_progress_callback_stops_the_eigensolver() {
         calls, 3,
         "the solver stops at the first report answered with false"
     );
-    assert!(started.elapsed().as_secs_f64() < 2.0);
 }

@@ -112,13 +112,6 @@ fn random_direction(rng: &mut ChaCha8Rng, len: f64) -> V3 {
 
 /// Length of the diagonal of the bounding box of `points`.
 pub(crate) fn bounding_box_diagonal(points: &[V3]) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = crate::shape::bounding_box(points);
     dist(lo, hi).max(0.0)
 }
