@@ -259,7 +259,10 @@ fn cancelling_stops_the_pipeline_promptly() {
             "{cancel_at:?}: {:?}",
             result.map(|r| r.k)
         );
-        assert_eq!(calls_after, 0, "{cancel_at:?}: progress went on after cancelling");
+        assert_eq!(
+            calls_after, 0,
+            "{cancel_at:?}: progress went on after cancelling"
+        );
     }
 }
 
