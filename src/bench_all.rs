@@ -342,6 +342,13 @@ fn run_dataset(p: &AllParams, dataset: &Dataset) -> Result<DatasetResults> {
         },
     )?;
     let methods = select_methods(&p.pointwise, params, None)?;
+    // Each shape keeps its eigenbasis and geodesic solver until its last pair, then is
+    // released (the solvers are the largest items): nothing is made twice.
+    let last_use: BTreeMap<&str, usize> = pairs
+        .iter()
+        .enumerate()
+        .flat_map(|(i, q)| [(q.source.as_str(), i), (q.target.as_str(), i)])
+        .collect();
     out.p2p = resumable(
         &mut out.counts,
         &logs.join(format!(
@@ -353,8 +360,16 @@ fn run_dataset(p: &AllParams, dataset: &Dataset) -> Result<DatasetResults> {
         &|r: &PairScores| (r.source.clone(), r.target.clone()),
         &mut |pair| {
             let scores = pointwise_pair(&mut store, pair, params, &methods, p.p2p_samples);
-            // Geodesic solvers are the largest items: keep only this pair's shapes'.
-            store.retain(&[&pair.source, &pair.target]);
+            let index = pairs
+                .iter()
+                .position(|q| q == pair)
+                .expect("a pair of the list");
+            let needed: Vec<&str> = last_use
+                .iter()
+                .filter(|&(_, &last)| last > index)
+                .map(|(&name, _)| name)
+                .collect();
+            store.retain(&needed);
             scores
         },
     )?;

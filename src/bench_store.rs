@@ -265,25 +265,23 @@ impl ResultLog {
                 .collect::<std::io::Result<_>>()
                 .map_err(|e| Error::file(path, e.to_string()))?;
             let text_len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-            let mut offset = 0u64;
+            // Only the last line can be cut short (no newline, or not whole JSON).
             for (i, line) in lines.iter().enumerate() {
-                let end = offset + line.len() as u64 + 1;
-                let complete = end <= text_len;
+                let end = whole_bytes + line.len() as u64 + 1;
+                let last = i + 1 == lines.len();
                 match serde_json::from_str::<T>(line) {
-                    Ok(r) if complete => {
+                    Ok(r) if end <= text_len => {
                         results.push(r);
                         whole_bytes = end;
                     }
-                    _ if i + 1 == lines.len() => break,
-                    Err(e) => {
+                    Err(e) if !last => {
                         return Err(Error::file(
                             path,
                             format!("line {}: {e} (delete the file to start over)", i + 1),
                         ))
                     }
-                    Ok(_) => break,
+                    _ => break,
                 }
-                offset = end;
             }
         }
         let file = OpenOptions::new()

@@ -30,7 +30,6 @@
 //!    components of the absorbing level touch, they become one node (it is now one
 //!    connected set of that level), as [`crate::segmentation`] does with k-means fragments.
 
-use std::collections::BTreeMap;
 use std::time::Instant;
 
 use crate::correspondence::{one_to_one_matches, Correspondence, Params, Timings};
@@ -39,7 +38,7 @@ use crate::eigen::Eigenbasis;
 use crate::graph::ShapeGraph;
 use crate::matching::match_graphs;
 use crate::segmentation::{compare_graphs, Regions};
-use crate::shape::{DisjointSets, Shape};
+use crate::shape::Shape;
 use crate::{Error, Result};
 
 /// HKS time of the baseline on the unit-area shape (the crate's HKS convention: absolute
@@ -272,51 +271,13 @@ pub fn reeb_graph(
 
     // Components of every interval.
     let edges = shape.edges();
-    let mut sets = DisjointSets::new(n);
-    for &(u, v) in &edges {
-        if level[u as usize] == level[v as usize] {
-            sets.union(u as usize, v as usize);
-        }
-    }
-    let mut parts = Regions::default();
-    let mut part_of = vec![u32::MAX; n];
-    let mut part_of_root: BTreeMap<usize, u32> = BTreeMap::new();
-    for &v in active {
-        let next = parts.cluster.len() as u32;
-        let p = *part_of_root.entry(sets.find(v as usize)).or_insert(next);
-        if p == next {
-            parts.cluster.push(level[v as usize]);
-            parts.area.push(0.0);
-            parts.first_vertex.push(v);
-            parts.neighbours.push(BTreeMap::new());
-            parts.absorbed_into.push(u32::MAX);
-        }
-        part_of[v as usize] = p;
-        parts.area[p as usize] += mass[v as usize];
-    }
-    for &(u, v) in &edges {
-        let (pu, pv) = (part_of[u as usize], part_of[v as usize]);
-        if pu != pv {
-            *parts.neighbours[pu as usize].entry(pv).or_insert(0) += 1;
-            *parts.neighbours[pv as usize].entry(pu).or_insert(0) += 1;
-        }
-    }
+    let (mut parts, part_of) = Regions::components(n, active, &edges, &level, mass);
     if min_area_fraction > 0.0 {
         parts.merge_fragments(min_area_fraction * total_mass);
     }
 
     // Nodes: surviving parts numbered by smallest vertex.
-    let mut survivors: Vec<u32> = (0..parts.cluster.len() as u32)
-        .filter(|&p| parts.absorbed_into[p as usize] == u32::MAX)
-        .collect();
-    survivors.sort_by_key(|&p| parts.first_vertex[p as usize]);
-    let mut node_of_part = vec![u32::MAX; parts.cluster.len()];
-    for (node, &p) in survivors.iter().enumerate() {
-        node_of_part[p as usize] = node as u32;
-    }
-    for p in 0..parts.cluster.len() {
-        node_of_part[p] = node_of_part[parts.resolve(p as u32) as usize];
-    }
+    let (survivors, node_of_part) = parts.nodes();
     let n_nodes = survivors.len();
     let labels: Vec<u32> = shape
         .representative()

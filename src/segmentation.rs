@@ -1302,54 +1302,15 @@ fn build_graph(
     }
 
     // Regions: connected components of each cluster.
-    let mut sets = DisjointSets::new(n);
-    for &(u, v) in conn.edges {
-        if labels[u as usize] == labels[v as usize] {
-            sets.union(u as usize, v as usize);
-        }
-    }
-    let mut region_of = vec![u32::MAX; n];
-    let mut region_of_root: HashMap<usize, u32> = HashMap::new();
-    let mut regions = Regions::default();
-    for &v in active {
-        let root = sets.find(v as usize);
-        let next = regions.cluster.len() as u32;
-        let r = *region_of_root.entry(root).or_insert(next);
-        if r == next {
-            regions.cluster.push(labels[v as usize]);
-            regions.area.push(0.0);
-            regions.first_vertex.push(v);
-            regions.neighbours.push(BTreeMap::new());
-        }
-        region_of[v as usize] = r;
-        regions.area[r as usize] += mass[v as usize];
-    }
-    for &(u, v) in conn.edges {
-        let (ru, rv) = (region_of[u as usize], region_of[v as usize]);
-        if ru != rv {
-            *regions.neighbours[ru as usize].entry(rv).or_insert(0) += 1;
-            *regions.neighbours[rv as usize].entry(ru).or_insert(0) += 1;
-        }
-    }
+    let (mut regions, region_of) = Regions::components(n, active, conn.edges, labels, &mass);
     let first_vertex = regions.first_vertex.clone();
     let total_mass: f64 = regions.area.iter().sum();
-    regions.absorbed_into = vec![u32::MAX; regions.cluster.len()];
     if min_region_area > 0.0 {
         regions.merge_fragments(min_region_area * total_mass);
     }
 
     // Nodes: the surviving regions, numbered by smallest vertex.
-    let mut survivors: Vec<u32> = (0..regions.cluster.len() as u32)
-        .filter(|&r| regions.absorbed_into[r as usize] == u32::MAX)
-        .collect();
-    survivors.sort_by_key(|&r| regions.first_vertex[r as usize]);
-    let mut node_of_region = vec![u32::MAX; regions.cluster.len()];
-    for (node, &r) in survivors.iter().enumerate() {
-        node_of_region[r as usize] = node as u32;
-    }
-    for r in 0..regions.cluster.len() {
-        node_of_region[r] = node_of_region[regions.resolve(r as u32) as usize];
-    }
+    let (survivors, node_of_region) = regions.nodes();
     let n_nodes = survivors.len();
     let node_cluster: Vec<u32> = survivors
         .iter()
@@ -1564,6 +1525,66 @@ pub(crate) struct Regions {
 }
 
 impl Regions {
+    /// The connected components, over `edges`, of the active vertices of each label: their
+    /// label (`cluster`), area (sum of `mass`), smallest vertex and neighbours; with the
+    /// region of every vertex (`u32::MAX` for inactive ones). Nothing is merged yet.
+    pub(crate) fn components(
+        n: usize,
+        active: &[u32],
+        edges: &[(u32, u32)],
+        labels: &[u32],
+        mass: &[f64],
+    ) -> (Regions, Vec<u32>) {
+        let mut sets = DisjointSets::new(n);
+        for &(u, v) in edges {
+            if labels[u as usize] == labels[v as usize] {
+                sets.union(u as usize, v as usize);
+            }
+        }
+        let mut region_of = vec![u32::MAX; n];
+        let mut region_of_root: HashMap<usize, u32> = HashMap::new();
+        let mut regions = Regions::default();
+        for &v in active {
+            let next = regions.cluster.len() as u32;
+            let r = *region_of_root.entry(sets.find(v as usize)).or_insert(next);
+            if r == next {
+                regions.cluster.push(labels[v as usize]);
+                regions.area.push(0.0);
+                regions.first_vertex.push(v);
+                regions.neighbours.push(BTreeMap::new());
+                regions.absorbed_into.push(u32::MAX);
+            }
+            region_of[v as usize] = r;
+            regions.area[r as usize] += mass[v as usize];
+        }
+        for &(u, v) in edges {
+            let (ru, rv) = (region_of[u as usize], region_of[v as usize]);
+            if ru != rv {
+                *regions.neighbours[ru as usize].entry(rv).or_insert(0) += 1;
+                *regions.neighbours[rv as usize].entry(ru).or_insert(0) += 1;
+            }
+        }
+        (regions, region_of)
+    }
+
+    /// The regions that survived merging, numbered by smallest vertex (`survivors[node]` is
+    /// the region of that node), and the node of every region (merged ones: their
+    /// absorber's).
+    pub(crate) fn nodes(&self) -> (Vec<u32>, Vec<u32>) {
+        let mut survivors: Vec<u32> = (0..self.cluster.len() as u32)
+            .filter(|&r| self.absorbed_into[r as usize] == u32::MAX)
+            .collect();
+        survivors.sort_by_key(|&r| self.first_vertex[r as usize]);
+        let mut node_of_region = vec![u32::MAX; self.cluster.len()];
+        for (node, &r) in survivors.iter().enumerate() {
+            node_of_region[r as usize] = node as u32;
+        }
+        for r in 0..self.cluster.len() {
+            node_of_region[r] = node_of_region[self.resolve(r as u32) as usize];
+        }
+        (survivors, node_of_region)
+    }
+
     pub(crate) fn resolve(&self, mut r: u32) -> u32 {
         while self.absorbed_into[r as usize] != u32::MAX {
             r = self.absorbed_into[r as usize];
