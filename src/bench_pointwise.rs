@@ -84,6 +84,13 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
                 ..plain.clone()
             },
         ),
+        (
+            "regions+icp".into(),
+            PointwiseParams {
+                refinement: Refinement::Icp(crate::options::ICP_ITERATIONS),
+                ..plain.clone()
+            },
+        ),
         ("regions+zoomout".into(), base.clone()),
     ]
 }

@@ -11,12 +11,15 @@
 //! * [`project`]: spectral coefficients of functions.
 //! * [`solve_fmap`]: `min_C ||C A - B||^2 + w ||C Lambda_1 - Lambda_2 C||^2`, solved row by
 //!   row (the commutativity term is diagonal in the entries of C).
+//! * [`solve_fmap_commuting`]: the same plus commutativity with operator pairs
+//!   ([`Commutativity`]): [`multiplication_operators`] (Nogneng and Ovsjanikov 2017) and
+//!   [`orientation_operators`] (Ren et al. 2018), by preconditioned conjugate gradients.
 //! * [`fmap_to_p2p`]: nearest neighbours of the rows of `Phi_2` among the rows of
 //!   `Phi_1 C^T`, by a blocked dense search ([`nearest_rows`]).
 //! * [`p2p_to_fmap`]: `C = Phi_2^T M_2 Pi_21 Phi_1`.
 //! * [`zoomout`]: grow the basis step by step, alternating the two conversions.
 //! * [`icp_refine`]: spectral ICP: alternate conversion and projection of C on the
-//!   orthogonal matrices.
+//!   orthogonal matrices (on vertex samples, like ZoomOut).
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
@@ -74,66 +77,365 @@ pub fn solve_fmap(
     values_2: &[f64],
     laplacian_weight: f64,
 ) -> Result<Mat<f64>> {
-    let (k1, k2, d) = (coef_1.nrows(), coef_2.nrows(), coef_1.ncols());
-    if coef_2.ncols() != d || values_1.len() < k1 || values_2.len() < k2 {
-        return Err(Error::InvalidParameter {
-            name: "descriptors",
-            reason: format!(
-                "coefficients {k1}x{d} and {k2}x{} with {} and {} eigenvalues do not fit",
-                coef_2.ncols(),
-                values_1.len(),
-                values_2.len()
-            ),
-        });
-    }
-    let sq = |i: usize, j: usize| (values_1[j] - values_2[i]).powi(2);
-    let norm = (0..k2)
-        .flat_map(|i| (0..k1).map(move |j| (i, j)))
-        .map(|(i, j)| sq(i, j).powi(2))
-        .sum::<f64>()
-        .sqrt()
-        .max(f64::MIN_POSITIVE);
-    let mut gram = Mat::<f64>::zeros(k1, k1);
-    matmul(
-        gram.as_mut(),
-        Accum::Replace,
-        coef_1,
-        coef_1.transpose(),
-        1.0,
-        Par::Seq,
-    );
-    let mut rhs = Mat::<f64>::zeros(k1, k2);
-    matmul(
-        rhs.as_mut(),
-        Accum::Replace,
-        coef_1,
-        coef_2.transpose(),
-        1.0,
-        Par::Seq,
-    );
-    // A tiny ridge keeps every row's system positive definite when the descriptors do not
-    // span the basis and w = 0.
-    let ridge = 1e-10 * (0..k1).map(|j| gram[(j, j)]).sum::<f64>().max(1e-300) / k1 as f64;
+    let rows = RowSystems::new(coef_1, coef_2, values_1, values_2, laplacian_weight)?;
+    let (k1, k2) = (coef_1.nrows(), coef_2.nrows());
     let mut fmap = Mat::<f64>::zeros(k2, k1);
     for i in 0..k2 {
-        let system = Mat::from_fn(k1, k1, |r, c| {
-            gram[(r, c)]
-                + if r == c {
-                    laplacian_weight * sq(i, r) / norm + ridge
-                } else {
-                    0.0
-                }
-        });
+        let system = Mat::from_fn(k1, k1, |r, c| rows.entry(i, r, c));
         let llt = system.llt(Side::Lower).map_err(|e| Error::Numerical {
             stage: "functional map",
             reason: format!("row {i}: {e:?}"),
         })?;
-        let row = llt.solve(rhs.col(i).as_mat());
+        let row = llt.solve(rows.rhs.col(i).as_mat());
         for j in 0..k1 {
             fmap[(i, j)] = row[(j, 0)];
         }
     }
     Ok(fmap)
+}
+
+/// Multiplication operators `Phi[:, :k]^T M diag(f) Phi[:, :k]` (`k x k`, symmetric) of
+/// the columns `f` of `functions` (`n x d`), each column first scaled to unit M-norm: the
+/// descriptor operators of Nogneng and Ovsjanikov (2017).
+pub fn multiplication_operators(
+    vectors: MatRef<'_, f64>,
+    mass: &[f64],
+    k: usize,
+    functions: MatRef<'_, f64>,
+) -> Vec<Mat<f64>> {
+    let (n, k) = (vectors.nrows(), k.min(vectors.ncols()));
+    let phi = vectors.subcols(0, k);
+    (0..functions.ncols())
+        .into_par_iter()
+        .map(|j| {
+            let f = functions.col(j);
+            let norm = (0..n)
+                .map(|v| mass[v] * f[v] * f[v])
+                .sum::<f64>()
+                .sqrt()
+                .max(f64::MIN_POSITIVE);
+            let weighted = Mat::from_fn(n, k, |v, c| mass[v] * f[v] / norm * phi[(v, c)]);
+            let mut op = Mat::<f64>::zeros(k, k);
+            matmul(
+                op.as_mut(),
+                Accum::Replace,
+                phi.transpose(),
+                weighted.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            op
+        })
+        .collect()
+}
+
+/// Orientation operators `O_f = Phi^T W_f Phi` (`k x k`) of the columns `f` of `functions`
+/// (Ren et al. 2018): `g -> <n x grad f, grad g>`, integrated against the basis with
+/// piecewise-linear functions. On a triangle the integral of `h <n x grad f, grad g>` is
+/// `mean(h) sum_c g_c (f_(c-1) - f_(c+1)) / 2` (corners counter-clockwise), so `W_f` needs
+/// no geometry, only consistently oriented faces. An orientation-preserving map commutes
+/// with them, a reversing one anti-commutes. Each operator is scaled to unit Frobenius norm.
+pub fn orientation_operators(
+    vectors: MatRef<'_, f64>,
+    k: usize,
+    triangles: &[[u32; 3]],
+    functions: MatRef<'_, f64>,
+) -> Vec<Mat<f64>> {
+    let (n, k) = (vectors.nrows(), k.min(vectors.ncols()));
+    // The basis row by row (each vertex's k values contiguous) for the face loop.
+    let rows: Vec<f64> = (0..n)
+        .flat_map(|v| (0..k).map(move |c| vectors[(v, c)]))
+        .collect();
+    let phi = MatRef::from_row_major_slice(&rows, n, k);
+    (0..functions.ncols())
+        .into_par_iter()
+        .map(|j| {
+            let f = functions.col(j);
+            // W Phi, accumulated face by face: every corner of a face receives
+            // sum_c s_c Phi[v_c] with s_c = (f_(c-1) - f_(c+1)) / 6.
+            let mut w_phi = vec![0.0; n * k];
+            let mut sum = vec![0.0; k];
+            for t in triangles {
+                let v = t.map(|x| x as usize);
+                let s = [0, 1, 2].map(|c| (f[v[(c + 2) % 3]] - f[v[(c + 1) % 3]]) / 6.0);
+                let (r0, r1, r2) = (
+                    &rows[v[0] * k..][..k],
+                    &rows[v[1] * k..][..k],
+                    &rows[v[2] * k..][..k],
+                );
+                for c in 0..k {
+                    sum[c] = s[0] * r0[c] + s[1] * r1[c] + s[2] * r2[c];
+                }
+                for &corner in &v {
+                    for (w, x) in w_phi[corner * k..][..k].iter_mut().zip(&sum) {
+                        *w += x;
+                    }
+                }
+            }
+            let mut op = Mat::<f64>::zeros(k, k);
+            matmul(
+                op.as_mut(),
+                Accum::Replace,
+                phi.transpose(),
+                MatRef::from_row_major_slice(&w_phi, n, k),
+                1.0,
+                Par::Seq,
+            );
+            let norm = op.norm_l2();
+            if norm > 0.0 {
+                op *= faer::Scale(1.0 / norm);
+            }
+            op
+        })
+        .collect()
+}
+
+/// A commutativity term `w sum_f ||C D1_f - D2_f C||_F^2` with operators of corresponding
+/// descriptors on shape 1 (`k1 x k1`) and shape 2 (`k2 x k2`), in the same order:
+/// multiplication operators (Nogneng and Ovsjanikov 2017) or orientation operators (Ren
+/// et al. 2018).
+#[derive(Debug, Clone, Copy)]
+pub struct Commutativity<'a> {
+    pub operators_a: &'a [Mat<f64>],
+    pub operators_b: &'a [Mat<f64>],
+    pub weight: f64,
+}
+
+/// Largest number of conjugate-gradient iterations of [`solve_fmap_commuting`].
+const CG_MAX_ITERATIONS: usize = 1000;
+/// Relative residual at which [`solve_fmap_commuting`] stops.
+const CG_TOLERANCE: f64 = 1e-9;
+
+/// [`solve_fmap`] with commutativity terms added:
+/// `||C A - B||^2 + w_L ||C Lambda_1 - Lambda_2 C||^2 + sum_terms w sum_f ||C D1_f - D2_f C||^2`.
+/// The term couples the rows of C, so the normal equations are solved by conjugate
+/// gradients, preconditioned by the row-wise systems (sequential, hence deterministic).
+pub fn solve_fmap_commuting(
+    coef_1: MatRef<'_, f64>,
+    coef_2: MatRef<'_, f64>,
+    values_1: &[f64],
+    values_2: &[f64],
+    laplacian_weight: f64,
+    terms: &[Commutativity<'_>],
+) -> Result<Mat<f64>> {
+    let (k1, k2) = (coef_1.nrows(), coef_2.nrows());
+    let fits = |ops: &[Mat<f64>], k: usize| ops.iter().all(|d| d.nrows() == k && d.ncols() == k);
+    for term in terms {
+        let valid = term.operators_a.len() == term.operators_b.len()
+            && fits(term.operators_a, k1)
+            && fits(term.operators_b, k2)
+            && term.weight >= 0.0
+            && term.weight.is_finite();
+        if !valid {
+            return Err(Error::InvalidParameter {
+                name: "descriptor operators",
+                reason: format!(
+                    "need as many {k1}x{k1} operators on shape 1 as {k2}x{k2} on shape 2 and a \
+                     finite weight >= 0, got {} and {} with weight {}",
+                    term.operators_a.len(),
+                    term.operators_b.len(),
+                    term.weight
+                ),
+            });
+        }
+    }
+    let terms: Vec<&Commutativity<'_>> = terms
+        .iter()
+        .filter(|t| t.weight > 0.0 && !t.operators_a.is_empty())
+        .collect();
+    if terms.is_empty() {
+        return solve_fmap(coef_1, coef_2, values_1, values_2, laplacian_weight);
+    }
+    let rows = RowSystems::new(coef_1, coef_2, values_1, values_2, laplacian_weight)?;
+    // Sum over the terms of w D_a D_a^T and w D_b^T D_b.
+    let (mut s_a, mut s_b) = (Mat::<f64>::zeros(k1, k1), Mat::<f64>::zeros(k2, k2));
+    for term in &terms {
+        for (d_a, d_b) in term.operators_a.iter().zip(term.operators_b) {
+            matmul(
+                s_a.as_mut(),
+                Accum::Add,
+                d_a,
+                d_a.transpose(),
+                term.weight,
+                Par::Seq,
+            );
+            matmul(
+                s_b.as_mut(),
+                Accum::Add,
+                d_b.transpose(),
+                d_b,
+                term.weight,
+                Par::Seq,
+            );
+        }
+    }
+    // H(X) = X G + (lap o X) + sum_terms w sum_f (X D_a D_a^T + D_b^T D_b X - D_b X D_a^T
+    // - D_b^T X D_a): the Hessian of the energy over 2.
+    let apply = |x: &Mat<f64>| -> Mat<f64> {
+        let mut out = rows.apply(x);
+        matmul(out.as_mut(), Accum::Add, x, &s_a, 1.0, Par::Seq);
+        matmul(out.as_mut(), Accum::Add, &s_b, x, 1.0, Par::Seq);
+        let mut tmp = Mat::<f64>::zeros(k2, k1);
+        for term in &terms {
+            for (d_a, d_b) in term.operators_a.iter().zip(term.operators_b) {
+                matmul(tmp.as_mut(), Accum::Replace, d_b, x, 1.0, Par::Seq);
+                matmul(
+                    out.as_mut(),
+                    Accum::Add,
+                    &tmp,
+                    d_a.transpose(),
+                    -term.weight,
+                    Par::Seq,
+                );
+                matmul(
+                    tmp.as_mut(),
+                    Accum::Replace,
+                    d_b.transpose(),
+                    x,
+                    1.0,
+                    Par::Seq,
+                );
+                matmul(out.as_mut(), Accum::Add, &tmp, d_a, -term.weight, Par::Seq);
+            }
+        }
+        out
+    };
+    // Preconditioner: each row's system with the coupling dropped.
+    let factors = (0..k2)
+        .map(|i| {
+            let system = Mat::from_fn(k1, k1, |r, c| {
+                rows.entry(i, r, c) + s_a[(r, c)] + if r == c { s_b[(i, i)] } else { 0.0 }
+            });
+            system.llt(Side::Lower).map_err(|e| Error::Numerical {
+                stage: "functional map",
+                reason: format!("row {i}: {e:?}"),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let precondition = |r: &Mat<f64>| -> Mat<f64> {
+        let mut z = Mat::<f64>::zeros(k2, k1);
+        for (i, llt) in factors.iter().enumerate() {
+            let row = llt.solve(r.row(i).transpose().as_mat());
+            for j in 0..k1 {
+                z[(i, j)] = row[(j, 0)];
+            }
+        }
+        z
+    };
+    let dot = |a: &Mat<f64>, b: &Mat<f64>| -> f64 {
+        (0..k1)
+            .map(|j| (0..k2).map(|i| a[(i, j)] * b[(i, j)]).sum::<f64>())
+            .sum()
+    };
+    let rhs = rows.rhs();
+    let rhs_norm = dot(&rhs, &rhs).sqrt().max(f64::MIN_POSITIVE);
+    // Start from the solution without the coupling term's off-row part.
+    let mut x = precondition(&rhs);
+    let mut r = &rhs - apply(&x);
+    let mut z = precondition(&r);
+    let mut p = z.clone();
+    let mut rz = dot(&r, &z);
+    for _ in 0..CG_MAX_ITERATIONS {
+        if dot(&r, &r).sqrt() <= CG_TOLERANCE * rhs_norm {
+            break;
+        }
+        let hp = apply(&p);
+        let alpha = rz / dot(&p, &hp);
+        x += alpha * &p;
+        r -= alpha * &hp;
+        z = precondition(&r);
+        let rz_next = dot(&r, &z);
+        p = &z + (rz_next / rz) * &p;
+        rz = rz_next;
+    }
+    Ok(x)
+}
+
+/// The row-separable part of the functional-map energy: `||C A - B||^2` and the Laplacian
+/// commutativity, whose normal equations for row `i` of C are
+/// `(A A^T + w diag((lambda_1 - lambda_2,i)^2)) c_i = A b_i^T`.
+struct RowSystems {
+    gram: Mat<f64>,
+    /// `A B^T` (`k1 x k2`): column `i` is row `i`'s right-hand side.
+    rhs: Mat<f64>,
+    /// `w (lambda_1,j - lambda_2,i)^2 / norm + ridge`, indexed `(i, j)`.
+    diagonal: Mat<f64>,
+}
+
+impl RowSystems {
+    fn new(
+        coef_1: MatRef<'_, f64>,
+        coef_2: MatRef<'_, f64>,
+        values_1: &[f64],
+        values_2: &[f64],
+        laplacian_weight: f64,
+    ) -> Result<RowSystems> {
+        let (k1, k2, d) = (coef_1.nrows(), coef_2.nrows(), coef_1.ncols());
+        if coef_2.ncols() != d || values_1.len() < k1 || values_2.len() < k2 {
+            return Err(Error::InvalidParameter {
+                name: "descriptors",
+                reason: format!(
+                    "coefficients {k1}x{d} and {k2}x{} with {} and {} eigenvalues do not fit",
+                    coef_2.ncols(),
+                    values_1.len(),
+                    values_2.len()
+                ),
+            });
+        }
+        let sq = |i: usize, j: usize| (values_1[j] - values_2[i]).powi(2);
+        let norm = (0..k2)
+            .flat_map(|i| (0..k1).map(move |j| (i, j)))
+            .map(|(i, j)| sq(i, j).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            .max(f64::MIN_POSITIVE);
+        let mut gram = Mat::<f64>::zeros(k1, k1);
+        matmul(
+            gram.as_mut(),
+            Accum::Replace,
+            coef_1,
+            coef_1.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        let mut rhs = Mat::<f64>::zeros(k1, k2);
+        matmul(
+            rhs.as_mut(),
+            Accum::Replace,
+            coef_1,
+            coef_2.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        // A tiny ridge keeps every row's system positive definite when the descriptors do
+        // not span the basis and w = 0.
+        let ridge = 1e-10 * (0..k1).map(|j| gram[(j, j)]).sum::<f64>().max(1e-300) / k1 as f64;
+        let diagonal = Mat::from_fn(k2, k1, |i, j| laplacian_weight * sq(i, j) / norm + ridge);
+        Ok(RowSystems {
+            gram,
+            rhs,
+            diagonal,
+        })
+    }
+
+    /// Entry `(r, c)` of row `i`'s system matrix.
+    fn entry(&self, i: usize, r: usize, c: usize) -> f64 {
+        self.gram[(r, c)] + if r == c { self.diagonal[(i, r)] } else { 0.0 }
+    }
+
+    /// The right-hand sides as a `k2 x k1` matrix (row `i` for row `i` of C).
+    fn rhs(&self) -> Mat<f64> {
+        self.rhs.transpose().to_owned()
+    }
+
+    /// `X G + diagonal o X` for a `k2 x k1` matrix X.
+    fn apply(&self, x: &Mat<f64>) -> Mat<f64> {
+        let mut out = Mat::from_fn(x.nrows(), x.ncols(), |i, j| {
+            self.diagonal[(i, j)] * x[(i, j)]
+        });
+        matmul(out.as_mut(), Accum::Add, x, &self.gram, 1.0, Par::Seq);
+        out
+    }
 }
 
 /// For every row of `query` (`m x k`), the index of the nearest row of `target` (`n x k`)
@@ -412,41 +714,64 @@ fn weighted_fmap(
 
 /// Spectral ICP (Ovsjanikov et al. 2012, section 6.1): alternate the pointwise map of C and
 /// the orthogonal matrix nearest to the functional map of that pointwise map, for
-/// `iterations` rounds or until the map stops changing. Returns `fmap_12` and `p2p_21`.
+/// `iterations` rounds or until the map stops changing. Like [`zoomout`], the rounds run on
+/// seeded vertex samples of `sample_size` per shape (0 = every vertex), then one
+/// full-resolution conversion. Returns `fmap_12` and `p2p_21`.
 pub fn icp_refine(
     fmap_12: MatRef<'_, f64>,
     phi_1: MatRef<'_, f64>,
+    mass_1: &[f64],
     phi_2: MatRef<'_, f64>,
     mass_2: &[f64],
     iterations: usize,
+    sample_size: usize,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
     let (k2, k1) = (fmap_12.nrows(), fmap_12.ncols());
+    if k1 != k2 || k1 > phi_1.ncols().min(phi_2.ncols()) {
+        return Err(Error::InvalidParameter {
+            name: "icp",
+            reason: format!(
+                "need a square map no larger than the bases ({} and {}), got {k2}x{k1}",
+                phi_1.ncols(),
+                phi_2.ncols()
+            ),
+        });
+    }
+    let sample = |mass: &[f64], seed| {
+        if sample_size == 0 {
+            Sample::all(mass)
+        } else {
+            Sample::random(mass, sample_size, seed)
+        }
+    };
+    let (sample_1, sample_2) = (sample(mass_1, SAMPLE_SEED), sample(mass_2, SAMPLE_SEED + 1));
+    let (sub_1, sub_2) = (sample_1.rows(phi_1, k1), sample_2.rows(phi_2, k2));
     let mut fmap = fmap_12.to_owned();
-    let mut p2p = fmap_to_p2p(fmap.as_ref(), phi_1, phi_2);
+    let mut p2p = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
     for _ in 0..iterations {
-        let c = p2p_to_fmap(&p2p, phi_1, phi_2, mass_2, k1, k2);
+        let vertices: Vec<u32> = p2p.iter().map(|&s| sample_1.vertices[s as usize]).collect();
+        let c = weighted_fmap(&vertices, phi_1, sub_2.as_ref(), &sample_2.weights, k1)?;
         let svd = c.svd().map_err(|e| Error::Numerical {
             stage: "spectral ICP",
             reason: format!("{e:?}"),
         })?;
-        let u = svd.U().subcols(0, k2.min(k1));
-        let v = svd.V().subcols(0, k2.min(k1));
         let mut next = Mat::<f64>::zeros(k2, k1);
         matmul(
             next.as_mut(),
             Accum::Replace,
-            u,
-            v.transpose(),
+            svd.U(),
+            svd.V().transpose(),
             1.0,
             Par::Seq,
         );
         fmap = next;
-        let next_p2p = fmap_to_p2p(fmap.as_ref(), phi_1, phi_2);
+        let next_p2p = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
         let unchanged = next_p2p == p2p;
         p2p = next_p2p;
         if unchanged {
             break;
         }
     }
-    Ok((fmap, p2p))
+    let p2p_21 = fmap_to_p2p(fmap.as_ref(), phi_1, phi_2);
+    Ok((fmap, p2p_21))
 }

@@ -275,6 +275,12 @@ struct PointwiseArgs {
     /// Weight of the Laplacian commutativity term.
     #[arg(long)]
     laplacian_weight: Option<f64>,
+    /// Weight of the descriptor commutativity term (0 = off).
+    #[arg(long)]
+    descriptor_commutativity: Option<f64>,
+    /// Weight of the orientation-preserving term (0 = off).
+    #[arg(long)]
+    orientation_term: Option<f64>,
     /// Diffusion times of the region indicators, comma separated.
     #[arg(long, value_delimiter = ',')]
     region_times: Option<Vec<f64>>,
@@ -338,6 +344,12 @@ impl PointwiseArgs {
         };
         if let Some(v) = self.laplacian_weight {
             p.laplacian_weight = v;
+        }
+        if let Some(v) = self.descriptor_commutativity {
+            p.descriptor_commutativity = v;
+        }
+        if let Some(v) = self.orientation_term {
+            p.orientation_term = v;
         }
         if let Some(v) = &self.region_times {
             p.region_times = v.clone();

@@ -227,6 +227,16 @@ pub const OPTIONS: &[OptionInfo] = &[
         "pointwise map: weight of the Laplacian commutativity term",
     ),
     p2p(
+        "p2p_descriptor_commutativity",
+        Float,
+        "pointwise map: weight of the descriptor commutativity term (0 = off)",
+    ),
+    p2p(
+        "p2p_orientation_term",
+        Float,
+        "pointwise map: weight of the orientation-preserving term (0 = off)",
+    ),
+    p2p(
         "p2p_refinement",
         Int,
         "pointwise map: refinement: 0 none, 1 ZoomOut, 2 spectral ICP",
@@ -510,9 +520,18 @@ impl Options {
                 }
             }
             OptionValue::Float(v) => {
+                // Every pointwise float option is a weight.
                 let v = to_finite(info, v)?;
+                if v < 0.0 {
+                    return Err(Error::InvalidParameter {
+                        name: info.name,
+                        reason: format!("a weight must be >= 0, got {v}"),
+                    });
+                }
                 match info.name {
                     "p2p_laplacian_weight" => p.laplacian_weight = v,
+                    "p2p_descriptor_commutativity" => p.descriptor_commutativity = v,
+                    "p2p_orientation_term" => p.orientation_term = v,
                     other => unreachable!("float option {other} has no field"),
                 }
             }
@@ -544,6 +563,8 @@ impl Options {
             "p2p_wks" => OptionValue::Bool(p.wks.is_some()),
             "p2p_descriptor_step" => int(p.descriptor_step),
             "p2p_laplacian_weight" => OptionValue::Float(p.laplacian_weight),
+            "p2p_descriptor_commutativity" => OptionValue::Float(p.descriptor_commutativity),
+            "p2p_orientation_term" => OptionValue::Float(p.orientation_term),
             "p2p_refinement" => OptionValue::Int(match p.refinement {
                 Refinement::None => P2P_REFINEMENT_NONE,
                 Refinement::ZoomOut(_) => P2P_REFINEMENT_ZOOMOUT,
@@ -649,6 +670,8 @@ mod tests {
             ("p2p_fmap_size", OptionValue::Int(-2)),
             ("p2p_fmap_size", OptionValue::Float(2.0)),
             ("p2p_laplacian_weight", OptionValue::Float(f64::INFINITY)),
+            ("p2p_orientation_term", OptionValue::Float(-0.1)),
+            ("p2p_descriptor_commutativity", OptionValue::Float(f64::NAN)),
             ("p2p_wks", OptionValue::Int(1)),
         ] {
             let before = format!("{options:?}");
