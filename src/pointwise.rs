@@ -142,26 +142,17 @@ impl PointwiseParams {
         if self.descriptor_step == 0 {
             return bad("pointwise.descriptor_step", "must be at least 1".into());
         }
-        if !(self.descriptor_commutativity >= 0.0 && self.descriptor_commutativity.is_finite()) {
-            return bad(
+        for (name, weight) in [
+            (
                 "pointwise.descriptor_commutativity",
-                format!(
-                    "must be finite and >= 0, got {}",
-                    self.descriptor_commutativity
-                ),
-            );
-        }
-        if !(self.orientation_term >= 0.0 && self.orientation_term.is_finite()) {
-            return bad(
-                "pointwise.orientation_term",
-                format!("must be finite and >= 0, got {}", self.orientation_term),
-            );
-        }
-        if !(self.laplacian_weight >= 0.0 && self.laplacian_weight.is_finite()) {
-            return bad(
-                "pointwise.laplacian_weight",
-                format!("must be finite and >= 0, got {}", self.laplacian_weight),
-            );
+                self.descriptor_commutativity,
+            ),
+            ("pointwise.orientation_term", self.orientation_term),
+            ("pointwise.laplacian_weight", self.laplacian_weight),
+        ] {
+            if !(weight >= 0.0 && weight.is_finite()) {
+                return bad(name, format!("must be finite and >= 0, got {weight}"));
+            }
         }
         match &self.refinement {
             Refinement::ZoomOut(z)
