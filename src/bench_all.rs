@@ -705,7 +705,7 @@ fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
          its mirror image where a mirror map exists. The paper's columns: WKS, HKS, WKS + SEGS, \
          SEGS, SYM. Beyond the paper: regions+icp (SEGS refined by the spectral ICP of \
          Ovsjanikov et al. 2012, on 2000-vertex samples) and regions+zoomout (target 0.020). \
-         Every map with regions uses the orientation-preserving term and, on oriented meshes, \
+         Every map with regions uses the orientation-preserving term and, on orientable meshes, \
          the choice between the one-to-one answer and its mirror image.\n",
         if p.p2p_samples == 0 {
             "all".to_string()

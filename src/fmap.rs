@@ -38,6 +38,8 @@ const NN_BLOCK: usize = 256;
 
 /// Candidates per query re-ranked in double precision by [`nearest_rows`].
 const RERANK: usize = 4;
+/// Targets scanned per chunk of [`nearest_rows`] (a multiple of 8).
+const SCAN_LANES: usize = 32;
 
 /// Seed of ZoomOut's vertex samples.
 const SAMPLE_SEED: u64 = 0x200e;
@@ -450,11 +452,22 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
         "nearest_rows: dimensions differ"
     );
     let (n, dims) = (target.nrows(), target.ncols());
-    let (target_f64, query_f64) = (target, query);
+    // Row-major double-precision copies for the exact re-ranking (each row contiguous).
+    let row_major = |m: MatRef<'_, f64>| -> Vec<f64> {
+        let mut rows = vec![0.0; m.nrows() * dims];
+        for c in 0..dims {
+            for (i, &x) in m.col(c).iter().enumerate() {
+                rows[i * dims + c] = x;
+            }
+        }
+        rows
+    };
+    let (target_rows, query_rows) = (row_major(target), row_major(query));
     let target = Mat::<f32>::from_fn(n, dims, |i, j| target[(i, j)] as f32);
     let query = Mat::<f32>::from_fn(query.nrows(), dims, |i, j| query[(i, j)] as f32);
-    let target_norms: Vec<f32> = (0..n)
-        .map(|i| (0..target.ncols()).map(|j| target[(i, j)].powi(2)).sum())
+    let target_norms: Vec<f32> = target_rows
+        .chunks_exact(dims.max(1))
+        .map(|row| row.iter().map(|&x| (x as f32).powi(2)).sum())
         .collect();
     let starts: Vec<usize> = (0..query.nrows()).step_by(NN_BLOCK).collect();
     let blocks: Vec<Vec<u32>> = starts
@@ -482,21 +495,45 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
                     // precision distance decides among them (the expansion loses the last
                     // digits when two vertices' embeddings nearly coincide).
                     let mut best = [(f32::INFINITY, 0u32); RERANK];
-                    for (j, (&t, &dot)) in target_norms.iter().zip(column).enumerate() {
-                        let d = t - 2.0 * dot;
-                        if d < best[RERANK - 1].0 {
-                            let mut slot = RERANK - 1;
-                            while slot > 0 && d < best[slot - 1].0 {
-                                best[slot] = best[slot - 1];
-                                slot -= 1;
+                    // Chunk by chunk: the chunk's minimum in SIMD lanes first, the ordered
+                    // insertion only for a chunk that holds a candidate (the same result as
+                    // offering every target in order, three times the speed).
+                    let (norm_chunks, dot_chunks) = (
+                        target_norms.chunks_exact(SCAN_LANES),
+                        column.chunks_exact(SCAN_LANES),
+                    );
+                    let tail = norm_chunks.remainder().len();
+                    for (c, (norms, dots)) in norm_chunks.zip(dot_chunks).enumerate() {
+                        // `if x < m { x } else { m }` compiles to packed minimum
+                        // instructions (f32::min's NaN rule does not).
+                        let mut lanes = [f32::INFINITY; 8];
+                        for (group_norms, group_dots) in
+                            norms.chunks_exact(8).zip(dots.chunks_exact(8))
+                        {
+                            for l in 0..8 {
+                                let d = group_norms[l] - 2.0 * group_dots[l];
+                                lanes[l] = if d < lanes[l] { d } else { lanes[l] };
                             }
-                            best[slot] = (d, j as u32);
+                        }
+                        let least = lanes
+                            .iter()
+                            .fold(f32::INFINITY, |m, &d| if d < m { d } else { m });
+                        if least < best[RERANK - 1].0 {
+                            for l in 0..SCAN_LANES {
+                                offer(&mut best, c * SCAN_LANES + l, norms[l] - 2.0 * dots[l]);
+                            }
                         }
                     }
+                    for j in n - tail..n {
+                        offer(&mut best, j, target_norms[j] - 2.0 * column[j]);
+                    }
                     let q = start + r;
+                    let query_row = &query_rows[q * dims..][..dims];
                     let exact = |j: u32| {
-                        (0..dims)
-                            .map(|c| (query_f64[(q, c)] - target_f64[(j as usize, c)]).powi(2))
+                        query_row
+                            .iter()
+                            .zip(&target_rows[j as usize * dims..][..dims])
+                            .map(|(x, y)| (x - y).powi(2))
                             .sum::<f64>()
                     };
                     let mut winner = (f64::INFINITY, 0u32);
@@ -514,6 +551,19 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
         })
         .collect();
     blocks.concat()
+}
+
+/// Puts target `j` at squared distance `d` among the best [`RERANK`] so far (sorted, the
+/// earlier target first among equals).
+fn offer(best: &mut [(f32, u32); RERANK], j: usize, d: f32) {
+    if d < best[RERANK - 1].0 {
+        let mut slot = RERANK - 1;
+        while slot > 0 && d < best[slot - 1].0 {
+            best[slot] = best[slot - 1];
+            slot -= 1;
+        }
+        best[slot] = (d, j as u32);
+    }
 }
 
 /// The pointwise map `p2p_21` of a functional map `fmap_12` (`k2 x k1`): every vertex of
@@ -588,6 +638,23 @@ impl Sample {
         }
     }
 
+    /// [`Sample::random`] of `size` vertices, or [`Sample::all`] for `size` 0.
+    fn of_size(mass: &[f64], size: usize, seed: u64) -> Sample {
+        if size == 0 {
+            Sample::all(mass)
+        } else {
+            Sample::random(mass, size, seed)
+        }
+    }
+
+    /// Sample positions (indices into `vertices`) as vertex indices.
+    fn on_vertices(&self, positions: &[u32]) -> Vec<u32> {
+        positions
+            .iter()
+            .map(|&s| self.vertices[s as usize])
+            .collect()
+    }
+
     fn rows(&self, phi: MatRef<'_, f64>, k: usize) -> Mat<f64> {
         Mat::from_fn(self.vertices.len(), k, |i, j| {
             phi[(self.vertices[i] as usize, j)]
@@ -628,47 +695,106 @@ pub fn zoomout(
     mass_2: &[f64],
     params: &ZoomOutParams,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
-    let k_max = phi_1.ncols().min(phi_2.ncols());
-    if params.step == 0
-        || params.k_end > k_max
-        || params.k_end < fmap_12.nrows().min(fmap_12.ncols())
-    {
-        return Err(Error::InvalidParameter {
-            name: "zoomout",
-            reason: format!(
-                "need step >= 1 and start ({}) <= k_end ({}) <= eigenpairs ({k_max})",
-                fmap_12.nrows().min(fmap_12.ncols()),
-                params.k_end
-            ),
-        });
+    let run = ZoomOutRun::new(fmap_12, phi_1, mass_1, phi_2, mass_2, params)?;
+    let p2p_21 = fmap_to_p2p(run.fmap_12.as_ref(), phi_1, phi_2);
+    Ok((run.fmap_12, p2p_21))
+}
+
+/// ZoomOut's iterations without the final full-resolution conversion: the final functional
+/// map and its pointwise map between the samples.
+#[derive(Debug, Clone)]
+pub struct SampledZoomOut {
+    /// The final functional map (`k_end x k_end`).
+    pub fmap_12: Mat<f64>,
+    /// The vertices of shape 1 on which the iterations ran.
+    pub sample_1: Sample,
+    /// The vertices of shape 2 on which the iterations ran.
+    pub sample_2: Sample,
+    /// For every vertex of `sample_2`, its vertex of shape 1 (one of `sample_1`'s) under the
+    /// final map.
+    pub p2p_21: Vec<u32>,
+}
+
+/// [`zoomout`] up to, not including, the full-resolution conversion (for comparing
+/// candidate maps before paying for it).
+pub fn zoomout_on_samples(
+    fmap_12: MatRef<'_, f64>,
+    phi_1: MatRef<'_, f64>,
+    mass_1: &[f64],
+    phi_2: MatRef<'_, f64>,
+    mass_2: &[f64],
+    params: &ZoomOutParams,
+) -> Result<SampledZoomOut> {
+    let run = ZoomOutRun::new(fmap_12, phi_1, mass_1, phi_2, mass_2, params)?;
+    let p2p_sub = fmap_to_p2p(run.fmap_12.as_ref(), run.sub_1.as_ref(), run.sub_2.as_ref());
+    Ok(SampledZoomOut {
+        p2p_21: run.sample_1.on_vertices(&p2p_sub),
+        fmap_12: run.fmap_12,
+        sample_1: run.sample_1,
+        sample_2: run.sample_2,
+    })
+}
+
+/// ZoomOut's iterations on the samples.
+struct ZoomOutRun {
+    fmap_12: Mat<f64>,
+    sample_1: Sample,
+    sample_2: Sample,
+    /// The samples' rows of the bases (first `k_end` columns).
+    sub_1: Mat<f64>,
+    sub_2: Mat<f64>,
+}
+
+impl ZoomOutRun {
+    fn new(
+        fmap_12: MatRef<'_, f64>,
+        phi_1: MatRef<'_, f64>,
+        mass_1: &[f64],
+        phi_2: MatRef<'_, f64>,
+        mass_2: &[f64],
+        params: &ZoomOutParams,
+    ) -> Result<ZoomOutRun> {
+        let k_max = phi_1.ncols().min(phi_2.ncols());
+        if params.step == 0
+            || params.k_end > k_max
+            || params.k_end < fmap_12.nrows().min(fmap_12.ncols())
+        {
+            return Err(Error::InvalidParameter {
+                name: "zoomout",
+                reason: format!(
+                    "need step >= 1 and start ({}) <= k_end ({}) <= eigenpairs ({k_max})",
+                    fmap_12.nrows().min(fmap_12.ncols()),
+                    params.k_end
+                ),
+            });
+        }
+        let sample_1 = Sample::of_size(mass_1, params.sample_size, SAMPLE_SEED);
+        let sample_2 = Sample::of_size(mass_2, params.sample_size, SAMPLE_SEED + 1);
+        let sub_1 = sample_1.rows(phi_1, params.k_end);
+        let sub_2 = sample_2.rows(phi_2, params.k_end);
+        let mut fmap = fmap_12.to_owned();
+        let mut k = fmap.nrows().min(fmap.ncols());
+        while k < params.k_end {
+            // Pointwise map on the samples with the current map, then the functional map one
+            // step larger from it.
+            let p2p_sub = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
+            k = (k + params.step).min(params.k_end);
+            fmap = weighted_fmap(
+                &sample_1.on_vertices(&p2p_sub),
+                phi_1,
+                sub_2.as_ref(),
+                &sample_2.weights,
+                k,
+            )?;
+        }
+        Ok(ZoomOutRun {
+            fmap_12: fmap,
+            sample_1,
+            sample_2,
+            sub_1,
+            sub_2,
+        })
     }
-    let sample_1 = if params.sample_size == 0 {
-        Sample::all(mass_1)
-    } else {
-        Sample::random(mass_1, params.sample_size, SAMPLE_SEED)
-    };
-    let sample_2 = if params.sample_size == 0 {
-        Sample::all(mass_2)
-    } else {
-        Sample::random(mass_2, params.sample_size, SAMPLE_SEED + 1)
-    };
-    let sub_1 = sample_1.rows(phi_1, params.k_end);
-    let sub_2 = sample_2.rows(phi_2, params.k_end);
-    let mut fmap = fmap_12.to_owned();
-    let mut k = fmap.nrows().min(fmap.ncols());
-    while k < params.k_end {
-        // Pointwise map on the samples with the current map, then the functional map one
-        // step larger from it.
-        let p2p_sub = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
-        k = (k + params.step).min(params.k_end);
-        let p2p_vertices: Vec<u32> = p2p_sub
-            .iter()
-            .map(|&s| sample_1.vertices[s as usize])
-            .collect();
-        fmap = weighted_fmap(&p2p_vertices, phi_1, sub_2.as_ref(), &sample_2.weights, k)?;
-    }
-    let p2p_21 = fmap_to_p2p(fmap.as_ref(), phi_1, phi_2);
-    Ok((fmap, p2p_21))
 }
 
 /// `C_12 (k x k)` from a pointwise map given on sample rows of shape 2: the weighted least
@@ -737,19 +863,13 @@ pub fn icp_refine(
             ),
         });
     }
-    let sample = |mass: &[f64], seed| {
-        if sample_size == 0 {
-            Sample::all(mass)
-        } else {
-            Sample::random(mass, sample_size, seed)
-        }
-    };
-    let (sample_1, sample_2) = (sample(mass_1, SAMPLE_SEED), sample(mass_2, SAMPLE_SEED + 1));
+    let sample_1 = Sample::of_size(mass_1, sample_size, SAMPLE_SEED);
+    let sample_2 = Sample::of_size(mass_2, sample_size, SAMPLE_SEED + 1);
     let (sub_1, sub_2) = (sample_1.rows(phi_1, k1), sample_2.rows(phi_2, k2));
     let mut fmap = fmap_12.to_owned();
     let mut p2p = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
     for _ in 0..iterations {
-        let vertices: Vec<u32> = p2p.iter().map(|&s| sample_1.vertices[s as usize]).collect();
+        let vertices = sample_1.on_vertices(&p2p);
         let c = weighted_fmap(&vertices, phi_1, sub_2.as_ref(), &sample_2.weights, k1)?;
         let svd = c.svd().map_err(|e| Error::Numerical {
             stage: "spectral ICP",

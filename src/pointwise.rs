@@ -16,7 +16,8 @@ use crate::descriptors::{hks, wks, HksParams, WksParams};
 use crate::eigen::{EigenParams, Eigenbasis};
 use crate::fmap::{
     fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, project,
-    solve_fmap_commuting, zoomout, Commutativity, ZoomOutParams,
+    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, SampledZoomOut,
+    ZoomOutParams,
 };
 use crate::progress::{check, Progress, Stage};
 use crate::shape::Shape;
@@ -73,14 +74,16 @@ pub struct PointwiseParams {
     pub descriptor_commutativity: f64,
     /// Weight of the orientation-preserving term (Ren et al. 2018): the map commutes with
     /// every undiffused descriptor's orientation operator `g -> <n x grad f, grad g>`.
-    /// Used on consistently oriented meshes only (0 = off).
+    /// Used on orientable meshes (faces taken as [`Shape::oriented_triangles`]), not on
+    /// point clouds (0 = off).
     pub orientation_term: f64,
     /// Refinement of the first map.
     pub refinement: Refinement,
-    /// For consistently oriented meshes, choose between the one-to-one region answer and
-    /// its mirror image (the other choice of every symmetric group): both are solved (with
-    /// the orientation term) and refined by ZoomOut, and the map with the larger product of
-    /// A's vertices reached and B's triangles keeping their orientation wins.
+    /// For orientable meshes, choose between the one-to-one region answer and its mirror
+    /// image (another choice in every symmetric group): both are solved (with the
+    /// orientation term) and refined by ZoomOut on the samples, and the map with the larger
+    /// product of A's samples reached and B's sample triangles keeping their orientation
+    /// wins; only the winner is converted at full resolution.
     pub orientation: bool,
 }
 
@@ -223,13 +226,17 @@ impl PointwiseMap {
                 groups
             }
         };
+        // Both shapes' faces consistently oriented (None for point clouds and
+        // non-orientable surfaces): the orientation term and the mirror decision need them.
         // A one-to-one region answer may be the mirror image of the truth (paper, section
-        // 5.2): on consistently oriented meshes, its mirror image (the other choice of every
-        // symmetric group) is a second candidate.
-        let mirror = match (regions, params.regions) {
-            (Some(regions), RegionConstraints::OneToOne)
-                if params.orientation && oriented(a) && oriented(b) =>
-            {
+        // 5.2): on orientable meshes, its mirror image is a second candidate.
+        let faces = if params.orientation || params.orientation_term > 0.0 {
+            a.oriented_triangles().zip(b.oriented_triangles())
+        } else {
+            None
+        };
+        let mirror = match (regions, params.regions, &faces) {
+            (Some(regions), RegionConstraints::OneToOne, Some(_)) if params.orientation => {
                 Some(mirrored_groups(a, basis_a, b, basis_b, regions)).filter(|m| *m != groups)
             }
             _ => None,
@@ -237,31 +244,41 @@ impl PointwiseMap {
         let candidates: Vec<&[(Vec<u32>, Vec<u32>)]> = std::iter::once(groups.as_slice())
             .chain(mirror.as_deref())
             .collect();
-        let features = Features::new(a, basis_a, b, basis_b, regions, &candidates, params, k)?;
+        let orientation_faces = faces
+            .as_ref()
+            .filter(|_| params.orientation_term > 0.0)
+            .map(|(fa, fb)| (fa.as_slice(), fb.as_slice()));
+        let features = Features::new(
+            (a, basis_a),
+            (b, basis_b),
+            regions,
+            &candidates,
+            orientation_faces,
+            params,
+            k,
+        )?;
         let fmaps = (0..candidates.len())
             .map(|c| features.solve(c, basis_a, basis_b, params))
             .collect::<Result<Vec<_>>>()?;
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
         let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
-        let zoom = |fmap: &Mat<f64>, z: &ZoomOutParams| {
-            let z = ZoomOutParams {
-                k_end: z.k_end.min(basis_a.len()).min(basis_b.len()).max(k),
-                ..z.clone()
-            };
-            zoomout(
-                fmap.as_ref(),
-                phi_a,
-                &basis_a.mass,
-                phi_b,
-                &basis_b.mass,
-                &z,
-            )
+        // ZoomOut up to what both bases have, and at least the first map's size.
+        let clamped = |z: &ZoomOutParams| ZoomOutParams {
+            k_end: z.k_end.min(basis_a.len()).min(basis_b.len()).max(k),
+            ..z.clone()
         };
         let refine = |fmap: &Mat<f64>| -> Result<(Mat<f64>, Vec<u32>)> {
             match &params.refinement {
                 Refinement::None => Ok((fmap.clone(), fmap_to_p2p(fmap.as_ref(), phi_a, phi_b))),
-                Refinement::ZoomOut(z) => zoom(fmap, z),
+                Refinement::ZoomOut(z) => zoomout(
+                    fmap.as_ref(),
+                    phi_a,
+                    &basis_a.mass,
+                    phi_b,
+                    &basis_b.mass,
+                    &clamped(z),
+                ),
                 Refinement::Icp(iterations) => icp_refine(
                     fmap.as_ref(),
                     phi_a,
@@ -273,36 +290,47 @@ impl PointwiseMap {
                 ),
             }
         };
-        let (fmap_ab, p2p_ba) = if fmaps.len() == 1 {
-            refine(&fmaps[0])?
-        } else {
-            // The answer and its mirror image, each refined by ZoomOut. The orientation term
-            // makes the candidate whose regions agree with the orientation a consistent
-            // map, and the other a compromise that folds part of the shape onto itself or
-            // turns it over: it reaches fewer of A's vertices, or keeps the orientation of
-            // fewer triangles. The product of the two picked the consistent one on 24 hard
-            // FAUST pairs and 2 TOSCA cats, where each factor alone failed on some.
-            let decision = match &params.refinement {
-                Refinement::ZoomOut(z) => z.clone(),
-                _ => ZoomOutParams::default(),
-            };
-            let refined = fmaps
-                .iter()
-                .map(|fmap| zoom(fmap, &decision))
-                .collect::<Result<Vec<_>>>()?;
-            let score: Vec<f64> = refined
-                .iter()
-                .map(|(_, p2p)| {
-                    covered_vertices(p2p, a.n_vertices()) as f64
-                        * orientation_score(a, b, p2p).unwrap_or(0.0)
-                })
-                .collect();
-            let best =
-                (1..refined.len()).fold(0, |best, c| if score[c] > score[best] { c } else { best });
-            match &params.refinement {
-                Refinement::ZoomOut(_) => refined.into_iter().nth(best).expect("a candidate"),
-                _ => refine(&fmaps[best])?,
+        let (fmap_ab, p2p_ba) = match &faces {
+            Some((faces_a, faces_b)) if fmaps.len() > 1 => {
+                // The answer and its mirror image, each refined by ZoomOut on the samples.
+                // The orientation term makes the candidate whose regions agree with the
+                // orientation a consistent map, and the other a compromise that folds part
+                // of the shape onto itself or turns it over: it reaches fewer of A's
+                // samples, or keeps the orientation of fewer triangles. Only the winner is
+                // converted at full resolution.
+                let decision = match &params.refinement {
+                    Refinement::ZoomOut(z) => z.clone(),
+                    _ => ZoomOutParams::default(),
+                };
+                let mut sampled = fmaps
+                    .iter()
+                    .map(|fmap| {
+                        zoomout_on_samples(
+                            fmap.as_ref(),
+                            phi_a,
+                            &basis_a.mass,
+                            phi_b,
+                            &basis_b.mass,
+                            &clamped(&decision),
+                        )
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                let score: Vec<f64> = sampled
+                    .iter()
+                    .map(|s| sample_consistency((a, faces_a), (b, faces_b), s))
+                    .collect();
+                let best = (1..score.len())
+                    .fold(0, |best, c| if score[c] > score[best] { c } else { best });
+                match &params.refinement {
+                    Refinement::ZoomOut(_) => {
+                        let fmap = sampled.swap_remove(best).fmap_12;
+                        let p2p = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b);
+                        (fmap, p2p)
+                    }
+                    _ => refine(&fmaps[best])?,
+                }
             }
+            _ => refine(&fmaps[0])?,
         };
         Ok(PointwiseMap {
             p2p_ba,
@@ -313,15 +341,6 @@ impl PointwiseMap {
             },
         })
     }
-}
-
-/// Number of distinct vertices of A that the map reaches.
-fn covered_vertices(p2p_ba: &[u32], n_a: usize) -> usize {
-    let mut hit = vec![false; n_a];
-    for &v in p2p_ba {
-        hit[v as usize] = true;
-    }
-    hit.into_iter().filter(|&h| h).count()
 }
 
 /// Descriptor columns of one shape, computed once for every region set any candidate uses.
@@ -349,7 +368,7 @@ impl SideFeatures {
         params: &PointwiseParams,
         k: usize,
         with_multiplication: bool,
-        with_orientation: bool,
+        oriented_faces: Option<&[[u32; 3]]>,
     ) -> Result<SideFeatures> {
         let operators = |functions: faer::MatRef<'_, f64>| -> (Vec<Mat<f64>>, Vec<Mat<f64>>) {
             let multiplication = if with_multiplication {
@@ -357,11 +376,9 @@ impl SideFeatures {
             } else {
                 Vec::new()
             };
-            let orientation = if with_orientation {
-                orientation_operators(basis.vectors.as_ref(), k, shape.triangles(), functions)
-            } else {
-                Vec::new()
-            };
+            let orientation = oriented_faces.map_or(Vec::new(), |faces| {
+                orientation_operators(basis.vectors.as_ref(), k, faces, functions)
+            });
             (multiplication, orientation)
         };
         let mut features = SideFeatures {
@@ -429,6 +446,9 @@ impl SideFeatures {
     }
 }
 
+/// Both shapes' consistently oriented faces (A's, then B's).
+type FacePair<'a> = (&'a [[u32; 3]], &'a [[u32; 3]]);
+
 /// The descriptors of both shapes for every candidate set of region groups.
 struct Features {
     a: SideFeatures,
@@ -439,13 +459,14 @@ struct Features {
 
 impl Features {
     #[allow(clippy::too_many_arguments)]
+    /// `orientation_faces`: both shapes' consistently oriented faces when the orientation
+    /// term is on.
     fn new(
-        a: &Shape,
-        basis_a: &Eigenbasis,
-        b: &Shape,
-        basis_b: &Eigenbasis,
+        (a, basis_a): (&Shape, &Eigenbasis),
+        (b, basis_b): (&Shape, &Eigenbasis),
         regions: Option<&Correspondence>,
         candidates: &[&[(Vec<u32>, Vec<u32>)]],
+        orientation_faces: Option<FacePair<'_>>,
         params: &PointwiseParams,
         k: usize,
     ) -> Result<Features> {
@@ -466,24 +487,26 @@ impl Features {
             })
             .collect();
         let multiplication = params.descriptor_commutativity > 0.0;
-        let orientation = params.orientation_term > 0.0 && oriented(a) && oriented(b);
-        let side = |shape, basis, labels, sets: &[Vec<u32>]| {
-            SideFeatures::new(
-                shape,
-                basis,
-                labels,
-                sets,
-                params,
-                k,
-                multiplication,
-                orientation,
-            )
+        let side = |shape, basis, labels, sets: &[Vec<u32>], faces| {
+            SideFeatures::new(shape, basis, labels, sets, params, k, multiplication, faces)
         };
         let labels_a = regions.map(|r| (r.regions_a(), r.graph_a.n_nodes()));
         let labels_b = regions.map(|r| (r.regions_b(), r.graph_b.n_nodes()));
         Ok(Features {
-            a: side(a, basis_a, labels_a, &sets_a)?,
-            b: side(b, basis_b, labels_b, &sets_b)?,
+            a: side(
+                a,
+                basis_a,
+                labels_a,
+                &sets_a,
+                orientation_faces.map(|f| f.0),
+            )?,
+            b: side(
+                b,
+                basis_b,
+                labels_b,
+                &sets_b,
+                orientation_faces.map(|f| f.1),
+            )?,
             candidates: pairs,
         })
     }
@@ -537,71 +560,135 @@ impl Features {
     }
 }
 
-/// Fraction of B's triangles whose image under `p2p_ba` keeps its orientation on A
-/// (the mapped triangle's normal agrees with A's vertex normals there); `None` when either
-/// shape is a point cloud or has inconsistently oriented faces, or no triangle maps to a
-/// proper triangle.
-pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
-    if !oriented(a) || !oriented(b) {
-        return None;
+/// How consistent a map refined on samples is, without converting it at full resolution:
+/// the fraction of A's sample vertices that B's samples reach, times the fraction of small
+/// triangles of B's samples (each sample and its two nearest samples) whose image keeps its
+/// orientation (judged by the vertex normals of the oriented faces on each side). A map
+/// that folds part of the shape onto itself reaches fewer samples; one that turns part of
+/// it over reverses more triangles.
+fn sample_consistency(
+    (a, faces_a): (&Shape, &[[u32; 3]]),
+    (b, faces_b): (&Shape, &[[u32; 3]]),
+    sampled: &SampledZoomOut,
+) -> f64 {
+    let (va, vb) = (a.vertices(), b.vertices());
+    let (normals_a, normals_b) = (vertex_normals(va, faces_a), vertex_normals(vb, faces_b));
+    let samples_b = &sampled.sample_2.vertices;
+    let mut reached = vec![false; va.len()];
+    for &v in &sampled.p2p_21 {
+        reached[v as usize] = true;
     }
-    let va = a.vertices();
-    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-    let cross = |u: [f64; 3], v: [f64; 3]| {
-        [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ]
-    };
-    let mut normals = vec![[0.0; 3]; va.len()];
-    for t in a.triangles() {
-        let n = cross(
-            sub(va[t[1] as usize], va[t[0] as usize]),
-            sub(va[t[2] as usize], va[t[0] as usize]),
+    let coverage = reached.iter().filter(|&&r| r).count() as f64
+        / sampled.sample_1.vertices.len().max(1) as f64;
+    let points: Vec<[f64; 3]> = samples_b.iter().map(|&v| vb[v as usize]).collect();
+    let tree = crate::neighbors::PointTree::new(&points);
+    let (mut kept, mut total) = (0usize, 0usize);
+    for (s, p) in points.iter().enumerate() {
+        let near = tree.nearest_k(p, 3);
+        let corners: Vec<usize> = std::iter::once(s)
+            .chain(near.iter().map(|&(j, _)| j).filter(|&j| j != s))
+            .take(3)
+            .collect();
+        if corners.len() < 3 {
+            continue;
+        }
+        let side_b = signed_turn(
+            vb,
+            corners.iter().map(|&c| samples_b[c] as usize),
+            &normals_b,
         );
+        let images = corners.iter().map(|&c| sampled.p2p_21[c] as usize);
+        let side_a = signed_turn(va, images, &normals_a);
+        if side_a != 0.0 && side_b != 0.0 {
+            total += 1;
+            if (side_a > 0.0) == (side_b > 0.0) {
+                kept += 1;
+            }
+        }
+    }
+    coverage * kept as f64 / total.max(1) as f64
+}
+
+/// Fraction of B's triangles whose image under `p2p_ba` keeps its orientation on A
+/// (the mapped triangle's normal agrees with A's vertex normals there), both shapes' faces
+/// taken as [`Shape::oriented_triangles`]; `None` when either shape is a point cloud or
+/// not orientable, or no triangle maps to a proper triangle.
+pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
+    orientation_kept(
+        a.vertices(),
+        &a.oriented_triangles()?,
+        &b.oriented_triangles()?,
+        p2p_ba,
+    )
+}
+
+/// [`orientation_score`] with both shapes' oriented faces given.
+fn orientation_kept(
+    va: &[[f64; 3]],
+    triangles_a: &[[u32; 3]],
+    triangles_b: &[[u32; 3]],
+    p2p_ba: &[u32],
+) -> Option<f64> {
+    let normals = vertex_normals(va, triangles_a);
+    let (mut kept, mut total) = (0usize, 0usize);
+    for t in triangles_b {
+        let turn = signed_turn(va, t.iter().map(|&v| p2p_ba[v as usize] as usize), &normals);
+        if turn != 0.0 {
+            total += 1;
+            if turn > 0.0 {
+                kept += 1;
+            }
+        }
+    }
+    (total > 0).then(|| kept as f64 / total as f64)
+}
+
+/// Area-weighted vertex normals (not normalised) of oriented faces.
+fn vertex_normals(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<[f64; 3]> {
+    let mut normals = vec![[0.0; 3]; vertices.len()];
+    for t in faces {
+        let [p, q, r] = t.map(|v| vertices[v as usize]);
+        let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
         for &v in t {
             for c in 0..3 {
                 normals[v as usize][c] += n[c];
             }
         }
     }
-    let (mut kept, mut total) = (0usize, 0usize);
-    for t in b.triangles() {
-        let m = t.map(|v| p2p_ba[v as usize] as usize);
-        if m[0] == m[1] || m[1] == m[2] || m[0] == m[2] {
-            continue;
-        }
-        let n = cross(sub(va[m[1]], va[m[0]]), sub(va[m[2]], va[m[0]]));
-        let reference: f64 = (0..3)
-            .map(|c| n[c] * (normals[m[0]][c] + normals[m[1]][c] + normals[m[2]][c]))
-            .sum();
-        total += 1;
-        if reference > 0.0 {
-            kept += 1;
-        }
-    }
-    (total > 0).then(|| kept as f64 / total as f64)
+    normals
 }
 
-/// True for a mesh whose faces are consistently oriented (no point cloud).
-fn oriented(s: &Shape) -> bool {
-    s.kind() == crate::shape::ShapeKind::Mesh
-        && !s
-            .warnings()
-            .iter()
-            .any(|w| matches!(w, crate::shape::Warning::InconsistentOrientation { .. }))
+/// The triangle of three vertices, seen against their summed vertex normals: positive when it
+/// turns counter-clockwise about them, negative when clockwise, 0 when two corners coincide.
+fn signed_turn(
+    vertices: &[[f64; 3]],
+    corners: impl Iterator<Item = usize>,
+    normals: &[[f64; 3]],
+) -> f64 {
+    let c: Vec<usize> = corners.collect();
+    if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
+        return 0.0;
+    }
+    let [p, q, r] = [c[0], c[1], c[2]].map(|v| vertices[v]);
+    let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
+    let reference: [f64; 3] =
+        std::array::from_fn(|i| normals[c[0]][i] + normals[c[1]][i] + normals[c[2]][i]);
+    crate::shape::dot(&n, &reference)
 }
 
 /// Largest number of alternative matchings enumerated for one symmetric group when
-/// looking for the mirror-image answer (a 4x4 group of two left/right pairs has 9).
+/// looking for the mirror-image answer (a 4x4 group of two left/right pairs has 23 besides
+/// the current one).
 const MIRROR_OPTIONS_CAP: usize = 5040;
 
 /// The mirror image of the one-to-one answer: in every symmetric group with a choice, a
-/// matching of the same size that shares no pair with the current one (for a left/right
-/// pair: the swap), the groups chosen together to minimise the distortion of region
-/// distances ([`crate::symmetry::distortion_energy`]) by a few sweeps of coordinate
-/// descent. Returned as one-to-one groups; equal to `groups` when no group has a choice.
+/// different matching of the same size (for a left/right pair: the swap), the groups chosen
+/// together to minimise the distortion of region distances
+/// ([`crate::symmetry::distortion_energy`]) by a few sweeps of coordinate descent. A region
+/// may keep its partner: a centaur's group of two arms and a middle region mirrors by
+/// swapping the arms only (requiring every pair to change, as this did before, left such
+/// groups no true mirror, and the centaurs' maps mirrored). Returned as one-to-one groups;
+/// equal to `groups` when no group has a choice.
 fn mirrored_groups(
     a: &Shape,
     basis_a: &Eigenbasis,
@@ -614,22 +701,27 @@ fn mirrored_groups(
     let mut fixed: Vec<(u32, u32)> = Vec::new();
     let mut choices: Vec<Vec<Vec<(u32, u32)>>> = Vec::new();
     for (ra, rb) in crate::symmetry::bipartite_groups(&regions.matches) {
-        let mine: Vec<(u32, u32)> = current
+        let mut mine: Vec<(u32, u32)> = current
             .iter()
             .copied()
             .filter(|p| ra.contains(&p.0))
             .collect();
+        mine.sort_unstable();
         let options = if ra.len() <= rb.len() {
-            alternative_matchings(&ra, &rb, &|x, y| allowed(x, y) && !mine.contains(&(x, y)))
+            alternative_matchings(&ra, &rb, &allowed)
         } else {
-            alternative_matchings(&rb, &ra, &|y, x| allowed(x, y) && !mine.contains(&(x, y)))
+            alternative_matchings(&rb, &ra, &|y, x| allowed(x, y))
                 .into_iter()
                 .map(|m| m.into_iter().map(|(y, x)| (x, y)).collect())
                 .collect()
         };
         let full: Vec<Vec<(u32, u32)>> = options
             .into_iter()
-            .filter(|m: &Vec<(u32, u32)>| m.len() == mine.len())
+            .map(|mut m: Vec<(u32, u32)>| {
+                m.sort_unstable();
+                m
+            })
+            .filter(|m| m.len() == mine.len() && *m != mine)
             .collect();
         if ra.len() + rb.len() <= 2 || full.is_empty() || full.len() > MIRROR_OPTIONS_CAP {
             fixed.extend(mine);

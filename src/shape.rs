@@ -314,6 +314,100 @@ impl Shape {
         }
     }
 
+    /// The faces with one consistent orientation, each connected piece facing outward
+    /// (positive signed volume about its centroid; for a flat open piece, the orientation
+    /// most of its faces had). Orientation is carried across edges shared by exactly two
+    /// faces, so a few flipped faces (an [`Warning::InconsistentOrientation`]) are turned
+    /// back and pieces joined only at non-manifold edges are oriented separately. `None`
+    /// for a point cloud and for a non-orientable surface (a Moebius strip). The orientation
+    /// terms of the pointwise map need it; the Laplacian does not.
+    pub fn oriented_triangles(&self) -> Option<Vec<[u32; 3]>> {
+        if self.kind == ShapeKind::PointCloud {
+            return None;
+        }
+        let faces = &self.triangles;
+        // For every undirected edge, the faces using it and whether each runs it low -> high.
+        let mut uses: HashMap<(u32, u32), Vec<(u32, bool)>> = HashMap::new();
+        for (f, t) in faces.iter().enumerate() {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                uses.entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push((f as u32, a < b));
+            }
+        }
+        let edge_of = |t: &[u32; 3], c: usize| {
+            let (a, b) = (t[c], t[(c + 1) % 3]);
+            ((a.min(b), a.max(b)), a < b)
+        };
+        // Breadth-first over faces; flip[f]: whether face f must be reversed.
+        let mut flip: Vec<Option<bool>> = vec![None; faces.len()];
+        let mut oriented = faces.clone();
+        let mut queue = std::collections::VecDeque::new();
+        for start in 0..faces.len() {
+            if flip[start].is_some() {
+                continue;
+            }
+            flip[start] = Some(false);
+            queue.push_back(start);
+            let mut piece = Vec::new();
+            while let Some(f) = queue.pop_front() {
+                piece.push(f);
+                let flipped = flip[f].expect("queued faces have a flip");
+                for c in 0..3 {
+                    let (key, forward) = edge_of(&faces[f], c);
+                    let users = &uses[&key];
+                    if users.len() != 2 {
+                        continue;
+                    }
+                    let (g, g_forward) = users[if users[0].0 as usize == f { 1 } else { 0 }];
+                    // Neighbours agree when they run the shared edge in opposite directions.
+                    let want = flipped ^ (forward == g_forward);
+                    match flip[g as usize] {
+                        None => {
+                            flip[g as usize] = Some(want);
+                            queue.push_back(g as usize);
+                        }
+                        Some(have) if have != want => return None,
+                        Some(_) => {}
+                    }
+                }
+            }
+            // The piece's orientation up to one sign: outward by its signed volume.
+            let turned = |f: usize| {
+                let t = faces[f];
+                if flip[f] == Some(true) {
+                    [t[0], t[2], t[1]]
+                } else {
+                    t
+                }
+            };
+            let mut centroid = [0.0; 3];
+            for &f in &piece {
+                for &v in &faces[f] {
+                    for (c, x) in centroid.iter_mut().zip(self.vertices[v as usize]) {
+                        *c += x / (3 * piece.len()) as f64;
+                    }
+                }
+            }
+            let (mut volume, mut area) = (0.0, 0.0);
+            for &f in &piece {
+                let [a, b, c] = turned(f).map(|v| sub(&self.vertices[v as usize], &centroid));
+                volume += dot(&a, &cross(&b, &c)) / 6.0;
+                area += triangle_area(&self.vertices, &faces[f]);
+            }
+            let reverse = if volume.abs() > 1e-6 * area.powf(1.5) {
+                volume < 0.0
+            } else {
+                2 * piece.iter().filter(|&&f| flip[f] == Some(true)).count() > piece.len()
+            };
+            for &f in &piece {
+                let t = turned(f);
+                oriented[f] = if reverse { [t[0], t[2], t[1]] } else { t };
+            }
+        }
+        Some(oriented)
+    }
+
     fn count_needle_faces(&self, total_area: f64) -> usize {
         let mean = total_area / self.triangles.len() as f64;
         self.triangles

@@ -274,3 +274,87 @@ fn malformed_files_give_file_errors_naming_the_file() {
     ));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn oriented_triangles_turn_flipped_and_inward_faces_outward() {
+    let (v, f) = sphere(); // outward-facing
+    let same_cycle =
+        |t: [u32; 3], u: [u32; 3]| (0..3).any(|r| [t[r], t[(r + 1) % 3], t[(r + 2) % 3]] == u);
+    let outward = |faces: &[[u32; 3]]| {
+        faces.len() == f.len() && faces.iter().zip(&f).all(|(&t, &u)| same_cycle(t, u))
+    };
+    // Already consistent and outward: unchanged.
+    let shape = Shape::mesh(v.clone(), &f).unwrap();
+    assert_eq!(shape.oriented_triangles().unwrap(), f);
+    // Every face turned inward, then a few of them back: each of the three is repaired to
+    // the outward orientation.
+    let inward: Vec<[u32; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let mut mixed = inward.clone();
+    for t in mixed.iter_mut().step_by(7) {
+        *t = [t[0], t[2], t[1]];
+    }
+    let mut few = f.clone();
+    for t in few.iter_mut().step_by(11) {
+        *t = [t[1], t[0], t[2]];
+    }
+    for faces in [&inward, &mixed, &few] {
+        let shape = Shape::mesh(v.clone(), faces).unwrap();
+        assert!(outward(&shape.oriented_triangles().unwrap()));
+    }
+    // Two spheres, one inward, one outward: each piece on its own.
+    let mut two_v = v.clone();
+    two_v.extend(v.iter().map(|p| [p[0] + 5.0, p[1], p[2]]));
+    let n = v.len() as u32;
+    let mut two_f = inward.clone();
+    two_f.extend(f.iter().map(|t| t.map(|i| i + n)));
+    let two = Shape::mesh(two_v, &two_f).unwrap();
+    let oriented = two.oriented_triangles().unwrap();
+    assert!(outward(&oriented[..f.len()]));
+    assert!(oriented[f.len()..]
+        .iter()
+        .zip(&f)
+        .all(|(&t, u)| same_cycle(t, u.map(|i| i + n))));
+    // A point cloud has no faces to orient.
+    assert!(Shape::point_cloud(v.clone())
+        .unwrap()
+        .oriented_triangles()
+        .is_none());
+}
+
+#[test]
+fn a_moebius_strip_has_no_orientation() {
+    // A strip of 40 quads around a circle, its ends joined with a half twist.
+    let segments = 40u32;
+    let mut vertices = Vec::new();
+    for i in 0..segments {
+        let angle = std::f64::consts::TAU * i as f64 / segments as f64;
+        let twist = angle / 2.0;
+        for side in [-1.0, 1.0] {
+            let r = 2.0 + 0.5 * side * twist.cos();
+            vertices.push([r * angle.cos(), r * angle.sin(), 0.5 * side * twist.sin()]);
+        }
+    }
+    let mut faces = Vec::new();
+    for i in 0..segments {
+        let (a, b) = (2 * i, 2 * i + 1);
+        // The last quad joins the first edge upside down (the half twist).
+        let (c, d) = if i + 1 < segments {
+            (2 * i + 2, 2 * i + 3)
+        } else {
+            (1, 0)
+        };
+        faces.push([a, b, d]);
+        faces.push([a, d, c]);
+    }
+    let strip = Shape::mesh(vertices.clone(), &faces).unwrap();
+    assert!(strip.oriented_triangles().is_none());
+    // The same strip cut open is orientable (its faces were consistent: kept, or all
+    // reversed by the sign of the enclosed volume).
+    let open: Vec<[u32; 3]> = faces[..faces.len() - 2].to_vec();
+    let reversed: Vec<[u32; 3]> = open.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let cut = Shape::mesh(vertices, &open)
+        .unwrap()
+        .oriented_triangles()
+        .unwrap();
+    assert!(cut == open || cut == reversed);
+}
