@@ -315,9 +315,17 @@ impl PointwiseMap {
                         )
                     })
                     .collect::<Result<Vec<_>>>()?;
+                let normals_a = vertex_normals(a.vertices(), faces_a);
+                let normals_b = vertex_normals(b.vertices(), faces_b);
                 let score: Vec<f64> = sampled
                     .iter()
-                    .map(|s| sample_consistency((a, faces_a), (b, faces_b), s))
+                    .map(|s| {
+                        sample_consistency(
+                            (a.vertices(), &normals_a),
+                            (b.vertices(), &normals_b),
+                            s,
+                        )
+                    })
                     .collect();
                 let best = (1..score.len())
                     .fold(0, |best, c| if score[c] > score[best] { c } else { best });
@@ -563,16 +571,14 @@ impl Features {
 /// How consistent a map refined on samples is, without converting it at full resolution:
 /// the fraction of A's sample vertices that B's samples reach, times the fraction of small
 /// triangles of B's samples (each sample and its two nearest samples) whose image keeps its
-/// orientation (judged by the vertex normals of the oriented faces on each side). A map
-/// that folds part of the shape onto itself reaches fewer samples; one that turns part of
-/// it over reverses more triangles.
+/// orientation (judged by each side's vertex normals of its oriented faces). A map that
+/// folds part of the shape onto itself reaches fewer samples; one that turns part of it
+/// over reverses more triangles.
 fn sample_consistency(
-    (a, faces_a): (&Shape, &[[u32; 3]]),
-    (b, faces_b): (&Shape, &[[u32; 3]]),
+    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
+    (vb, normals_b): (&[[f64; 3]], &[[f64; 3]]),
     sampled: &SampledZoomOut,
 ) -> f64 {
-    let (va, vb) = (a.vertices(), b.vertices());
-    let (normals_a, normals_b) = (vertex_normals(va, faces_a), vertex_normals(vb, faces_b));
     let samples_b = &sampled.sample_2.vertices;
     let mut reached = vec![false; va.len()];
     for &v in &sampled.p2p_21 {
@@ -595,10 +601,10 @@ fn sample_consistency(
         let side_b = signed_turn(
             vb,
             corners.iter().map(|&c| samples_b[c] as usize),
-            &normals_b,
+            normals_b,
         );
         let images = corners.iter().map(|&c| sampled.p2p_21[c] as usize);
-        let side_a = signed_turn(va, images, &normals_a);
+        let side_a = signed_turn(va, images, normals_a);
         if side_a != 0.0 && side_b != 0.0 {
             total += 1;
             if (side_a > 0.0) == (side_b > 0.0) {
