@@ -45,7 +45,8 @@ pub enum Warning {
     DisconnectedPieces { count: usize },
     /// Edges shared by more than two faces (the Laplacian handles them).
     NonManifoldEdges { count: usize },
-    /// Neighbouring faces with opposite orientation (the Laplacian does not depend on it).
+    /// Neighbouring faces with opposite orientation (the Laplacian does not depend on it; the
+    /// pointwise map uses [`Shape::oriented_triangles`]).
     InconsistentOrientation { edges: usize },
     /// Faces with (near) zero area but distinct corners; the Laplacian mollifies them.
     NeedleOrZeroAreaFaces { count: usize },
@@ -75,7 +76,7 @@ impl std::fmt::Display for Warning {
             }
             Warning::InconsistentOrientation { edges } => write!(
                 f,
-                "{edges} edges join faces of opposite orientation (harmless for the Laplacian)"
+                "{edges} edges join faces of opposite orientation (harmless for the Laplacian; re-oriented for the pointwise map)"
             ),
             Warning::NeedleOrZeroAreaFaces { count } => write!(
                 f,
