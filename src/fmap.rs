@@ -465,9 +465,13 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
     let (target_rows, query_rows) = (row_major(target), row_major(query));
     let target = Mat::<f32>::from_fn(n, dims, |i, j| target[(i, j)] as f32);
     let query = Mat::<f32>::from_fn(query.nrows(), dims, |i, j| query[(i, j)] as f32);
-    let target_norms: Vec<f32> = target_rows
-        .chunks_exact(dims.max(1))
-        .map(|row| row.iter().map(|&x| (x as f32).powi(2)).sum())
+    let target_norms: Vec<f32> = (0..n)
+        .map(|i| {
+            target_rows[i * dims..][..dims]
+                .iter()
+                .map(|&x| (x as f32).powi(2))
+                .sum()
+        })
         .collect();
     let starts: Vec<usize> = (0..query.nrows()).step_by(NN_BLOCK).collect();
     let blocks: Vec<Vec<u32>> = starts
@@ -497,7 +501,7 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
                     let mut best = [(f32::INFINITY, 0u32); RERANK];
                     // Chunk by chunk: the chunk's minimum in SIMD lanes first, the ordered
                     // insertion only for a chunk that holds a candidate (the same result as
-                    // offering every target in order, three times the speed).
+                    // offering every target in order).
                     let (norm_chunks, dot_chunks) = (
                         target_norms.chunks_exact(SCAN_LANES),
                         column.chunks_exact(SCAN_LANES),

@@ -115,6 +115,9 @@ fn nearest_rows_equals_brute_force_with_lowest_index_on_ties() {
         );
     }
     assert_eq!(fast[0], 5);
+    // Without columns every target is at distance 0: the lowest index wins.
+    let empty = nearest_rows(target.subcols(0, 0), query.subcols(0, 0));
+    assert!(empty.len() == query.nrows() && empty.iter().all(|&t| t == 0));
 }
 
 #[test]
