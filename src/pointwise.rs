@@ -315,21 +315,18 @@ impl PointwiseMap {
                         )
                     })
                     .collect::<Result<Vec<_>>>()?;
+                // Every candidate ran on the same samples (fixed seeds).
+                let triangles_b = sample_triangles(
+                    b.vertices(),
+                    &vertex_normals(b.vertices(), faces_b),
+                    &sampled[0].sample_2.vertices,
+                );
                 let normals_a = vertex_normals(a.vertices(), faces_a);
-                let normals_b = vertex_normals(b.vertices(), faces_b);
                 let score: Vec<f64> = sampled
                     .iter()
-                    .map(|s| {
-                        sample_consistency(
-                            (a.vertices(), &normals_a),
-                            (b.vertices(), &normals_b),
-                            s,
-                        )
-                    })
+                    .map(|s| sample_consistency((a.vertices(), &normals_a), &triangles_b, s))
                     .collect();
-                let mut best =
-                    (1..score.len())
-                        .fold(0, |best, c| if score[c] > score[best] { c } else { best });
+                let mut best = argmax(&score);
                 let runner_up = (0..score.len())
                     .filter(|&c| c != best)
                     .map(|c| score[c])
@@ -343,23 +340,13 @@ impl PointwiseMap {
                         .zip(&mut full)
                         .map(|(s, slot)| {
                             let p2p = fmap_to_p2p(s.fmap_12.as_ref(), phi_a, phi_b);
-                            let mut reached = vec![false; a.n_vertices()];
-                            for &v in &p2p {
-                                reached[v as usize] = true;
-                            }
-                            let covered = reached.iter().filter(|&&r| r).count() as f64;
+                            let covered = covered_vertices(&p2p, a.n_vertices()) as f64;
                             let kept = orientation_kept(a.vertices(), faces_a, faces_b, &p2p);
                             *slot = Some(p2p);
                             covered * kept.unwrap_or(0.0)
                         })
                         .collect();
-                    best = (1..full_score.len()).fold(0, |best, c| {
-                        if full_score[c] > full_score[best] {
-                            c
-                        } else {
-                            best
-                        }
-                    });
+                    best = argmax(&full_score);
                 }
                 match &params.refinement {
                     Refinement::ZoomOut(_) => {
@@ -383,6 +370,20 @@ impl PointwiseMap {
             },
         })
     }
+}
+
+/// Number of distinct vertices of A that the map reaches.
+fn covered_vertices(p2p_ba: &[u32], n_a: usize) -> usize {
+    let mut hit = vec![false; n_a];
+    for &v in p2p_ba {
+        hit[v as usize] = true;
+    }
+    hit.into_iter().filter(|&h| h).count()
+}
+
+/// The index of the largest score (the first among equals).
+fn argmax(scores: &[f64]) -> usize {
+    (1..scores.len()).fold(0, |best, c| if scores[c] > scores[best] { c } else { best })
 }
 
 /// The mirror decision is a close call when the winner's sample score is below this many
@@ -506,7 +507,6 @@ struct Features {
 }
 
 impl Features {
-    #[allow(clippy::too_many_arguments)]
     /// `orientation_faces`: both shapes' consistently oriented faces when the orientation
     /// term is on.
     fn new(
@@ -608,46 +608,59 @@ impl Features {
     }
 }
 
-/// How consistent a map refined on samples is, without converting it at full resolution:
-/// the fraction of A's sample vertices that B's samples reach, times the fraction of small
-/// triangles of B's samples (each sample and its two nearest samples) whose image keeps its
-/// orientation (judged by each side's vertex normals of its oriented faces). A map that
-/// folds part of the shape onto itself reaches fewer samples; one that turns part of it
-/// over reverses more triangles.
-fn sample_consistency(
-    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
-    (vb, normals_b): (&[[f64; 3]], &[[f64; 3]]),
-    sampled: &SampledZoomOut,
-) -> f64 {
-    let samples_b = &sampled.sample_2.vertices;
-    let mut reached = vec![false; va.len()];
-    for &v in &sampled.p2p_21 {
-        reached[v as usize] = true;
-    }
-    let coverage = reached.iter().filter(|&&r| r).count() as f64
-        / sampled.sample_1.vertices.len().max(1) as f64;
+/// Small triangles of B's samples: each sample with its two nearest samples, as positions
+/// in `samples_b`, and whether it turns counter-clockwise about B's vertex normals
+/// (degenerate ones left out).
+fn sample_triangles(
+    vb: &[[f64; 3]],
+    normals_b: &[[f64; 3]],
+    samples_b: &[u32],
+) -> Vec<([usize; 3], bool)> {
     let points: Vec<[f64; 3]> = samples_b.iter().map(|&v| vb[v as usize]).collect();
     let tree = crate::neighbors::PointTree::new(&points);
-    let (mut kept, mut total) = (0usize, 0usize);
+    let mut triangles = Vec::with_capacity(points.len());
     for (s, p) in points.iter().enumerate() {
-        let near = tree.nearest_k(p, 3);
-        let corners: Vec<usize> = std::iter::once(s)
-            .chain(near.iter().map(|&(j, _)| j).filter(|&j| j != s))
-            .take(3)
+        let near: Vec<usize> = tree
+            .nearest_k(p, 3)
+            .into_iter()
+            .map(|(j, _)| j)
+            .filter(|&j| j != s)
+            .take(2)
             .collect();
-        if corners.len() < 3 {
-            continue;
+        if let [j, l] = near[..] {
+            let corners = [s, j, l];
+            let turn = signed_turn(
+                vb,
+                corners.iter().map(|&c| samples_b[c] as usize),
+                normals_b,
+            );
+            if turn != 0.0 {
+                triangles.push((corners, turn > 0.0));
+            }
         }
-        let side_b = signed_turn(
-            vb,
-            corners.iter().map(|&c| samples_b[c] as usize),
-            normals_b,
-        );
+    }
+    triangles
+}
+
+/// How consistent a map refined on samples is, without converting it at full resolution:
+/// the fraction of A's sample vertices that B's samples reach, times the fraction of B's
+/// [`sample_triangles`] whose image keeps its orientation (judged by A's vertex normals of
+/// its oriented faces). A map that folds part of the shape onto itself reaches fewer
+/// samples; one that turns part of it over reverses more triangles.
+fn sample_consistency(
+    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
+    triangles_b: &[([usize; 3], bool)],
+    sampled: &SampledZoomOut,
+) -> f64 {
+    let coverage = covered_vertices(&sampled.p2p_21, va.len()) as f64
+        / sampled.sample_1.vertices.len().max(1) as f64;
+    let (mut kept, mut total) = (0usize, 0usize);
+    for (corners, counter_clockwise) in triangles_b {
         let images = corners.iter().map(|&c| sampled.p2p_21[c] as usize);
-        let side_a = signed_turn(va, images, normals_a);
-        if side_a != 0.0 && side_b != 0.0 {
+        let turn = signed_turn(va, images, normals_a);
+        if turn != 0.0 {
             total += 1;
-            if (side_a > 0.0) == (side_b > 0.0) {
+            if (turn > 0.0) == *counter_clockwise {
                 kept += 1;
             }
         }
@@ -722,9 +735,9 @@ fn signed_turn(
     crate::shape::dot(&n, &reference)
 }
 
-/// Largest number of alternative matchings enumerated for one symmetric group when
-/// looking for the mirror-image answer (a 4x4 group of two left/right pairs has 23 besides
-/// the current one).
+/// Largest number of alternative matchings (besides the current one) enumerated for one
+/// symmetric group when looking for the mirror-image answer (a 4x4 group of two left/right
+/// pairs has 23); a group with more keeps its current matching.
 const MIRROR_OPTIONS_CAP: usize = 5040;
 
 /// The mirror image of the one-to-one answer: in every symmetric group with a choice, a
@@ -743,33 +756,21 @@ fn mirrored_groups(
     regions: &Correspondence,
 ) -> Vec<(Vec<u32>, Vec<u32>)> {
     let current = &regions.matches_one_to_one;
-    let allowed = |x: u32, y: u32| regions.matches.binary_search(&(x, y)).is_ok();
     let mut fixed: Vec<(u32, u32)> = Vec::new();
     let mut choices: Vec<Vec<Vec<(u32, u32)>>> = Vec::new();
     for (ra, rb) in crate::symmetry::bipartite_groups(&regions.matches) {
-        let mut mine: Vec<(u32, u32)> = current
-            .iter()
-            .copied()
-            .filter(|p| ra.contains(&p.0))
-            .collect();
+        let in_group = |p: &(u32, u32)| ra.binary_search(&p.0).is_ok();
+        let mut mine: Vec<(u32, u32)> = current.iter().copied().filter(in_group).collect();
         mine.sort_unstable();
-        let options = if ra.len() <= rb.len() {
-            alternative_matchings(&ra, &rb, &allowed)
-        } else {
-            alternative_matchings(&rb, &ra, &|y, x| allowed(x, y))
-                .into_iter()
-                .map(|m| m.into_iter().map(|(y, x)| (x, y)).collect())
-                .collect()
-        };
+        let edges: Vec<(u32, u32)> = regions.matches.iter().copied().filter(in_group).collect();
+        let (options, complete) =
+            crate::symmetry::max_matchings(&ra, &rb, &edges, MIRROR_OPTIONS_CAP + 1);
+        // Each option lists its pairs by ascending A region, as `mine` does.
         let full: Vec<Vec<(u32, u32)>> = options
             .into_iter()
-            .map(|mut m: Vec<(u32, u32)>| {
-                m.sort_unstable();
-                m
-            })
             .filter(|m| m.len() == mine.len() && *m != mine)
             .collect();
-        if ra.len() + rb.len() <= 2 || full.is_empty() || full.len() > MIRROR_OPTIONS_CAP {
+        if ra.len() + rb.len() <= 2 || full.is_empty() || !complete {
             fixed.extend(mine);
         } else {
             choices.push(full);
@@ -827,52 +828,6 @@ fn mirrored_groups(
     let mut pairs = assemble(&pick);
     pairs.sort_unstable();
     pairs.into_iter().map(|(i, j)| (vec![i], vec![j])).collect()
-}
-
-/// Every matching that gives each of `small` a distinct partner in `large` with
-/// `allowed(small, large)`, up to [`MIRROR_OPTIONS_CAP`] + 1 of them.
-fn alternative_matchings(
-    small: &[u32],
-    large: &[u32],
-    allowed: &dyn Fn(u32, u32) -> bool,
-) -> Vec<Vec<(u32, u32)>> {
-    fn extend(
-        i: usize,
-        small: &[u32],
-        large: &[u32],
-        allowed: &dyn Fn(u32, u32) -> bool,
-        used: &mut Vec<bool>,
-        partial: &mut Vec<(u32, u32)>,
-        out: &mut Vec<Vec<(u32, u32)>>,
-    ) {
-        if out.len() > MIRROR_OPTIONS_CAP {
-            return;
-        }
-        if i == small.len() {
-            out.push(partial.clone());
-            return;
-        }
-        for (j, &y) in large.iter().enumerate() {
-            if !used[j] && allowed(small[i], y) {
-                used[j] = true;
-                partial.push((small[i], y));
-                extend(i + 1, small, large, allowed, used, partial, out);
-                partial.pop();
-                used[j] = false;
-            }
-        }
-    }
-    let mut out = Vec::new();
-    extend(
-        0,
-        small,
-        large,
-        allowed,
-        &mut vec![false; large.len()],
-        &mut Vec::new(),
-        &mut out,
-    );
-    out
 }
 
 /// Everything from two shapes: eigenbases, region correspondence, pointwise map.

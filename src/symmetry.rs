@@ -676,7 +676,7 @@ pub fn min_cost_assignment(cost: &[f64], n: usize) -> Vec<usize> {
 /// The maximum-cardinality matchings of the bipartite graph `edges` between `a` and `b`
 /// (both sorted), in lexicographic order of the A regions' choices, at most `cap` of them;
 /// the flag is false when there were more.
-fn max_matchings(
+pub(crate) fn max_matchings(
     a: &[u32],
     b: &[u32],
     edges: &[(u32, u32)],
