@@ -215,8 +215,8 @@ fn shape_area(shape: &Shape) -> Result<f64> {
 
 #[allow(clippy::too_many_arguments)]
 /// Runs every method of [`methods`] on the pairs of `pairs_file` (layout from its name).
-/// `samples` ground-truth pairs per shape pair are scored (0 = all). `report` is called
-/// after every pair.
+/// `samples` ground-truth pairs per shape pair are scored (0 = all); eigenbases come from and
+/// go to `cache`. `report` is called after every pair.
 pub fn bench_pointwise(
     root: &Path,
     pairs_file: &Path,
@@ -225,6 +225,7 @@ pub fn bench_pointwise(
     samples: usize,
     only: Option<&[String]>,
     limit: Option<usize>,
+    cache: BasisCache,
     report: &mut dyn FnMut(usize, usize, &PairScores),
 ) -> Result<Vec<PairScores>> {
     let (dataset, pairs) = pair_list(root, pairs_file, limit)?;
@@ -233,7 +234,7 @@ pub fn bench_pointwise(
         n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
         ..params.eigen.clone()
     };
-    let mut store = ShapeStore::new(dataset, eigen, BasisCache::default());
+    let mut store = ShapeStore::new(dataset, eigen, cache);
     let mut results = Vec::with_capacity(pairs.len());
     for (index, pair) in pairs.iter().enumerate() {
         let outcome = pointwise_pair(&mut store, pair, params, &methods, samples)?;

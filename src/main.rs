@@ -196,6 +196,10 @@ enum BenchCommand {
         /// Only these methods (comma separated; default: all).
         #[arg(long, value_delimiter = ',')]
         methods: Option<Vec<String>>,
+        /// Keep the eigenbases in this folder and read them back on the next run (keyed by
+        /// the shape file's bytes and the eigensolver's parameters).
+        #[arg(long)]
+        basis_cache: Option<PathBuf>,
         #[command(flatten)]
         method: MethodArgs,
         #[command(flatten)]
@@ -520,6 +524,7 @@ fn run(cli: Cli) -> ExitCode {
                     curves,
                     json,
                     methods,
+                    basis_cache,
                     method,
                     pointwise,
                 },
@@ -530,6 +535,7 @@ fn run(cli: Cli) -> ExitCode {
                 limit,
                 samples,
                 methods.as_deref(),
+                basis_cache,
                 curves.as_deref(),
                 json.as_deref(),
                 &method.params(),
@@ -1093,6 +1099,7 @@ fn bench_p2p_command(
     limit: Option<usize>,
     samples: usize,
     only: Option<&[String]>,
+    basis_cache: Option<PathBuf>,
     curves: Option<&Path>,
     json_path: Option<&Path>,
     params: &Params,
@@ -1108,6 +1115,7 @@ fn bench_p2p_command(
         samples,
         only,
         limit,
+        shapecorr::bench_store::BasisCache { dir: basis_cache },
         &mut print_pair_scores,
     )?;
     println!(

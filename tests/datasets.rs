@@ -303,6 +303,60 @@ fn eigenbasis_cache_returns_the_same_basis_and_survives_damage() {
     assert_eq!(third.basis.values, first.basis.values);
 }
 
+/// `bench p2p --basis-cache DIR`: the first run writes both eigenbases to DIR, the second
+/// reads them back and scores the same.
+#[test]
+fn pointwise_bench_keeps_its_eigenbases_in_the_cache() {
+    let root = temp("p2p-cache");
+    for (name, mesh) in ["tr_reg_000", "tr_reg_001"].iter().zip(&poses()) {
+        let path = root.join("faust").join(format!("{name}.ply"));
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
+    }
+    let pairs = root.join("pairs/faust.txt");
+    write(
+        &pairs,
+        "# source\ttarget\tcategory\ntr_reg_000\ttr_reg_001\tsame\n",
+    );
+    let cache_dir = root.join("bases");
+    let run = || {
+        shapecorr::bench_pointwise::bench_pointwise(
+            &root,
+            &pairs,
+            &shapecorr::correspondence::Params::default(),
+            &shapecorr::pointwise::PointwiseParams::default(),
+            0,
+            Some(&["regions".to_string()]),
+            None,
+            BasisCache {
+                dir: Some(cache_dir.clone()),
+            },
+            &mut |_, _, _| {},
+        )
+        .unwrap()
+    };
+    let written = || -> Vec<std::time::SystemTime> {
+        let mut times: Vec<_> = std::fs::read_dir(&cache_dir)
+            .unwrap()
+            .map(|e| e.unwrap().metadata().unwrap().modified().unwrap())
+            .collect();
+        times.sort();
+        times
+    };
+    let first = run();
+    let before = written();
+    assert_eq!(before.len(), 2, "one cached eigenbasis per shape");
+    let second = run();
+    assert_eq!(
+        written(),
+        before,
+        "the second run reads the cache, writes nothing"
+    );
+    let (a, b) = (&first[0].scores[0], &second[0].scores[0]);
+    assert_eq!(a.error.mean, b.error.mean);
+    assert!(a.error.mean < 0.1, "mean error {}", a.error.mean);
+}
+
 #[test]
 fn shape_store_loads_once_and_cuts_nothing() {
     let root = temp("store");
