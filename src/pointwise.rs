@@ -341,7 +341,7 @@ impl PointwiseMap {
                         .map(|(s, slot)| {
                             let p2p = fmap_to_p2p(s.fmap_12.as_ref(), phi_a, phi_b);
                             let covered = covered_vertices(&p2p, a.n_vertices()) as f64;
-                            let kept = orientation_kept(a.vertices(), faces_a, faces_b, &p2p);
+                            let kept = orientation_kept((a.vertices(), &normals_a), faces_b, &p2p);
                             *slot = Some(p2p);
                             covered * kept.unwrap_or(0.0)
                         })
@@ -629,11 +629,7 @@ fn sample_triangles(
             .collect();
         if let [j, l] = near[..] {
             let corners = [s, j, l];
-            let turn = signed_turn(
-                vb,
-                corners.iter().map(|&c| samples_b[c] as usize),
-                normals_b,
-            );
+            let turn = signed_turn(vb, corners.map(|c| samples_b[c] as usize), normals_b);
             if turn != 0.0 {
                 triangles.push((corners, turn > 0.0));
             }
@@ -656,7 +652,7 @@ fn sample_consistency(
         / sampled.sample_1.vertices.len().max(1) as f64;
     let (mut kept, mut total) = (0usize, 0usize);
     for (corners, counter_clockwise) in triangles_b {
-        let images = corners.iter().map(|&c| sampled.p2p_21[c] as usize);
+        let images = corners.map(|c| sampled.p2p_21[c] as usize);
         let turn = signed_turn(va, images, normals_a);
         if turn != 0.0 {
             total += 1;
@@ -673,25 +669,20 @@ fn sample_consistency(
 /// taken as [`Shape::oriented_triangles`]; `None` when either shape is a point cloud or
 /// not orientable, or no triangle maps to a proper triangle.
 pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
-    orientation_kept(
-        a.vertices(),
-        &a.oriented_triangles()?,
-        &b.oriented_triangles()?,
-        p2p_ba,
-    )
+    let normals_a = vertex_normals(a.vertices(), &a.oriented_triangles()?);
+    orientation_kept((a.vertices(), &normals_a), &b.oriented_triangles()?, p2p_ba)
 }
 
-/// [`orientation_score`] with both shapes' oriented faces given.
+/// [`orientation_score`] with A's vertex normals ([`vertex_normals`] of its oriented faces)
+/// and B's oriented faces given.
 fn orientation_kept(
-    va: &[[f64; 3]],
-    triangles_a: &[[u32; 3]],
+    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
     triangles_b: &[[u32; 3]],
     p2p_ba: &[u32],
 ) -> Option<f64> {
-    let normals = vertex_normals(va, triangles_a);
     let (mut kept, mut total) = (0usize, 0usize);
     for t in triangles_b {
-        let turn = signed_turn(va, t.iter().map(|&v| p2p_ba[v as usize] as usize), &normals);
+        let turn = signed_turn(va, t.map(|v| p2p_ba[v as usize] as usize), normals_a);
         if turn != 0.0 {
             total += 1;
             if turn > 0.0 {
@@ -719,16 +710,11 @@ fn vertex_normals(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<[f64; 3]> {
 
 /// The triangle of three vertices, seen against their summed vertex normals: positive when it
 /// turns counter-clockwise about them, negative when clockwise, 0 when two corners coincide.
-fn signed_turn(
-    vertices: &[[f64; 3]],
-    corners: impl Iterator<Item = usize>,
-    normals: &[[f64; 3]],
-) -> f64 {
-    let c: Vec<usize> = corners.collect();
+fn signed_turn(vertices: &[[f64; 3]], c: [usize; 3], normals: &[[f64; 3]]) -> f64 {
     if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
         return 0.0;
     }
-    let [p, q, r] = [c[0], c[1], c[2]].map(|v| vertices[v]);
+    let [p, q, r] = c.map(|v| vertices[v]);
     let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
     let reference: [f64; 3] =
         std::array::from_fn(|i| normals[c[0]][i] + normals[c[1]][i] + normals[c[2]][i]);
