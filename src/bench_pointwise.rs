@@ -69,6 +69,14 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
                 ..descriptors_only.clone()
             },
         ),
+        (
+            "wks+icp".into(),
+            PointwiseParams {
+                wks: Some(WksParams::default()),
+                refinement: Refinement::Icp(crate::options::ICP_ITERATIONS),
+                ..descriptors_only.clone()
+            },
+        ),
         ("regions".into(), plain.clone()),
         (
             "regions+wks".into(),

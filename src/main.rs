@@ -172,7 +172,7 @@ enum BenchCommand {
         method: MethodArgs,
     },
     /// Pointwise maps over a pair list (like the paper's Table 2 and FAUST curves): WKS, HKS,
-    /// regions, regions + WKS, symmetric regions, regions + ZoomOut.
+    /// WKS + ICP, regions, regions + WKS, symmetric regions, regions + ICP, regions + ZoomOut.
     P2p {
         /// Dataset root (default: $SHAPECORR_DATA or ../shared/data).
         #[arg(long)]

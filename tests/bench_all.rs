@@ -76,6 +76,10 @@ fn quick_mode_writes_every_table_and_resumes() {
     // Table 2: regions + ZoomOut beats descriptors alone by a wide margin.
     let zoomout = row(&page, "| quick | regions+zoomout |");
     let wks = row(&page, "| quick | wks |");
+    for method in ["wks+icp", "regions+icp"] {
+        let refined = row(&page, &format!("| quick | {method} |"));
+        assert!(refined[2] < 0.5, "{method} error {}", refined[2]);
+    }
     assert!(zoomout[2] < 0.03, "regions+zoomout error {}", zoomout[2]);
     assert!(wks[2] > 2.0 * zoomout[2]);
     // Point clouds: accuracies in [0, 1] for both modes.
