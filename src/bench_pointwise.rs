@@ -53,14 +53,14 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
         regions: RegionConstraints::None,
         ..plain.clone()
     };
+    let wks_only = PointwiseParams {
+        wks: Some(WksParams::default()),
+        ..descriptors_only.clone()
+    };
+    // Ovsjanikov et al. 2012's refinement, the last step of the framework the paper uses.
+    let icp = Refinement::Icp(crate::options::ICP_ITERATIONS);
     vec![
-        (
-            "wks".into(),
-            PointwiseParams {
-                wks: Some(WksParams::default()),
-                ..descriptors_only.clone()
-            },
-        ),
+        ("wks".into(), wks_only.clone()),
         (
             "hks".into(),
             PointwiseParams {
@@ -72,9 +72,8 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
         (
             "wks+icp".into(),
             PointwiseParams {
-                wks: Some(WksParams::default()),
-                refinement: Refinement::Icp(crate::options::ICP_ITERATIONS),
-                ..descriptors_only.clone()
+                refinement: icp.clone(),
+                ..wks_only
             },
         ),
         ("regions".into(), plain.clone()),
@@ -95,7 +94,7 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
         (
             "regions+icp".into(),
             PointwiseParams {
-                refinement: Refinement::Icp(crate::options::ICP_ITERATIONS),
+                refinement: icp,
                 ..plain.clone()
             },
         ),
