@@ -100,7 +100,8 @@ impl Params {
 }
 
 /// Seconds spent in each stage.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Timings {
     pub eigenbasis_a: f64,
     pub eigenbasis_b: f64,
@@ -470,8 +471,8 @@ impl Symmetry {
 /// The one-to-one step (paper section 5.2) on symmetric `matches` between the regions of
 /// `graph_a` and `graph_b`: region-to-region distances on each shape, then
 /// [`one_to_one`]; empty when `params.skip_one_to_one`. Shared by the main method and the
-/// Reeb baseline ([`crate::reeb`]).
-pub(crate) fn one_to_one_matches(
+/// Reeb baseline (`shapecorr_eval::reeb`).
+pub fn one_to_one_matches(
     (a, basis_a, graph_a): (&Shape, &Eigenbasis, &ShapeGraph),
     (b, basis_b, graph_b): (&Shape, &Eigenbasis, &ShapeGraph),
     matches: &[(u32, u32)],

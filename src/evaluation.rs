@@ -7,10 +7,9 @@
 //! A's vertex. Large regions make accuracy easy, so the coverage (how much of B's area a
 //! vertex of A is matched to) is always reported beside it.
 
-use serde::{Deserialize, Serialize};
-
 /// Scores of one correspondence.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RegionScores {
     /// Accuracy of the symmetric (many-to-many) matches.
     pub symmetric: f64,
@@ -193,7 +192,8 @@ pub fn pointwise_errors(
 }
 
 /// Summary of one map's geodesic errors.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ErrorSummary {
     /// Mean normalised geodesic error.
     pub mean: f64,

@@ -34,13 +34,7 @@
 // with `partial_cmp` would hide that.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod bench;
-pub mod bench_all;
-pub mod bench_clouds;
-pub mod bench_pointwise;
-pub mod bench_store;
 pub mod correspondence;
-pub mod datasets;
 pub mod descriptors;
 pub mod eigen;
 pub mod error;
@@ -54,10 +48,8 @@ pub mod laplacian;
 pub mod matching;
 pub mod neighbors;
 pub mod options;
-pub mod plot;
 pub mod pointwise;
 pub mod progress;
-pub mod reeb;
 pub mod segmentation;
 pub mod shape;
 mod sparse;

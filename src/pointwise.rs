@@ -175,7 +175,8 @@ impl PointwiseParams {
 }
 
 /// Seconds per stage of the pointwise map.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PointwiseTimings {
     /// Descriptors and the first functional map.
     pub fmap: f64,

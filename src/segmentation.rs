@@ -1511,24 +1511,24 @@ fn first_or_second_edges(
 }
 
 /// Connected regions while fragments are merged (also the Reeb baseline's level components,
-/// [`crate::reeb`]).
+/// `shapecorr_eval::reeb`).
 #[derive(Default)]
-pub(crate) struct Regions {
+pub struct Regions {
     /// The cluster (Reeb: level interval) of each region.
-    pub(crate) cluster: Vec<u32>,
-    pub(crate) area: Vec<f64>,
-    pub(crate) first_vertex: Vec<u32>,
+    pub cluster: Vec<u32>,
+    pub area: Vec<f64>,
+    pub first_vertex: Vec<u32>,
     /// Neighbouring regions and the number of edges shared with each.
-    pub(crate) neighbours: Vec<BTreeMap<u32, u32>>,
+    pub neighbours: Vec<BTreeMap<u32, u32>>,
     /// The region this one was merged into (`u32::MAX`: still a region).
-    pub(crate) absorbed_into: Vec<u32>,
+    pub absorbed_into: Vec<u32>,
 }
 
 impl Regions {
     /// The connected components, over `edges`, of the active vertices of each label: their
     /// label (`cluster`), area (sum of `mass`), smallest vertex and neighbours; with the
     /// region of every vertex (`u32::MAX` for inactive ones). Nothing is merged yet.
-    pub(crate) fn components(
+    pub fn components(
         n: usize,
         active: &[u32],
         edges: &[(u32, u32)],
@@ -1570,7 +1570,7 @@ impl Regions {
     /// The regions that survived merging, numbered by smallest vertex (`survivors[node]` is
     /// the region of that node), and the node of every region (merged ones: their
     /// absorber's).
-    pub(crate) fn nodes(&self) -> (Vec<u32>, Vec<u32>) {
+    pub fn nodes(&self) -> (Vec<u32>, Vec<u32>) {
         let mut survivors: Vec<u32> = (0..self.cluster.len() as u32)
             .filter(|&r| self.absorbed_into[r as usize] == u32::MAX)
             .collect();
@@ -1585,7 +1585,7 @@ impl Regions {
         (survivors, node_of_region)
     }
 
-    pub(crate) fn resolve(&self, mut r: u32) -> u32 {
+    pub fn resolve(&self, mut r: u32) -> u32 {
         while self.absorbed_into[r as usize] != u32::MAX {
             r = self.absorbed_into[r as usize];
         }
@@ -1596,7 +1596,7 @@ impl Regions {
     /// most edges (ties: the larger, then the lower numbered); regions of the absorbing
     /// cluster that touched the fragment join too. A region without neighbours (a separate
     /// piece of the shape) stays.
-    pub(crate) fn merge_fragments(&mut self, threshold: f64) {
+    pub fn merge_fragments(&mut self, threshold: f64) {
         loop {
             let fragment = (0..self.cluster.len())
                 .filter(|&r| {
@@ -1869,12 +1869,7 @@ fn validate_inputs(
 }
 
 /// Degree histograms, connectivity and sizes of two graphs.
-pub(crate) fn compare_graphs(
-    k: usize,
-    a: &ShapeGraph,
-    b: &ShapeGraph,
-    max_regions: usize,
-) -> KCandidate {
+pub fn compare_graphs(k: usize, a: &ShapeGraph, b: &ShapeGraph, max_regions: usize) -> KCandidate {
     let (connected_a, connected_b) = (a.is_connected(), b.is_connected());
     let (n_nodes_a, n_nodes_b) = (a.n_nodes(), b.n_nodes());
     KCandidate {

@@ -22,16 +22,24 @@ pub const MIN_VERTICES: usize = 32;
 pub const POINT_CLOUD_GRAPH_K: usize = 6;
 
 /// Whether a shape is a triangle mesh or a point cloud.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum ShapeKind {
     Mesh,
     PointCloud,
 }
 
 /// Something in the input that was repaired or ignored rather than rejected.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum Warning {
     /// Faces with a repeated corner (zero area by construction) were dropped.
     DegenerateFacesDropped { count: usize },

@@ -7,7 +7,6 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use serde_json::json;
-use shapecorr::bench_pointwise::PairScores;
 use shapecorr::correspondence::{region_colors, Correspondence, Params, Symmetry};
 use shapecorr::evaluation::score_correspondence;
 use shapecorr::fmap::ZoomOutParams;
@@ -19,6 +18,7 @@ use shapecorr::pointwise::{
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
 use shapecorr::{EigenParams, Eigenbasis, Error, Laplacian, Shape, ShapeKind};
+use shapecorr_eval::bench_pointwise::PairScores;
 
 #[derive(Parser)]
 #[command(
@@ -579,7 +579,7 @@ fn run(cli: Cli) -> ExitCode {
                 if quick {
                     work.join("data")
                 } else {
-                    shapecorr::datasets::default_data_root()
+                    shapecorr_eval::datasets::default_data_root()
                 }
             });
             let out = out.unwrap_or_else(|| {
@@ -589,7 +589,7 @@ fn run(cli: Cli) -> ExitCode {
                     PathBuf::from("docs")
                 }
             });
-            let mut p = shapecorr::bench_all::AllParams::new(data, out, work, quick);
+            let mut p = shapecorr_eval::bench_all::AllParams::new(data, out, work, quick);
             p.datasets = datasets;
             p.limit = limit;
             p.p2p_samples = samples;
@@ -967,10 +967,15 @@ fn bench_regions_command(
     limit: Option<usize>,
     params: &Params,
 ) -> Result<(), Error> {
-    let root = data.unwrap_or_else(shapecorr::datasets::default_data_root);
+    let root = data.unwrap_or_else(shapecorr_eval::datasets::default_data_root);
     let started = Instant::now();
-    let results = shapecorr::bench::bench_regions(&root, pairs, params, limit, &mut |i, n, r| {
-        eprintln!(
+    let results = shapecorr_eval::bench::bench_regions(
+        &root,
+        pairs,
+        params,
+        limit,
+        &mut |i, n, r| {
+            eprintln!(
             "[{}/{}] {} -> {} ({}): symmetric {:.3}, one-to-one {:.3}{}, regions {}/{}, coverage {:.3}, k {}, {:.2} s",
             i + 1,
             n,
@@ -988,7 +993,8 @@ fn bench_regions_command(
             r.k,
             r.seconds
         );
-    })?;
+        },
+    )?;
     println!(
         "shapecorr {} bench regions --pairs {} ({} pairs, {:.0} s wall)",
         env!("CARGO_PKG_VERSION"),
@@ -996,7 +1002,7 @@ fn bench_regions_command(
         results.len(),
         started.elapsed().as_secs_f64()
     );
-    print!("{}", shapecorr::bench::summary_table(&results));
+    print!("{}", shapecorr_eval::bench::summary_table(&results));
     Ok(())
 }
 
@@ -1105,9 +1111,9 @@ fn bench_p2p_command(
     params: &Params,
     pointwise: &PointwiseParams,
 ) -> Result<(), Error> {
-    let root = data.unwrap_or_else(shapecorr::datasets::default_data_root);
+    let root = data.unwrap_or_else(shapecorr_eval::datasets::default_data_root);
     let started = Instant::now();
-    let results = shapecorr::bench_pointwise::bench_pointwise(
+    let results = shapecorr_eval::bench_pointwise::bench_pointwise(
         &root,
         pairs,
         params,
@@ -1115,7 +1121,7 @@ fn bench_p2p_command(
         samples,
         only,
         limit,
-        shapecorr::bench_store::BasisCache { dir: basis_cache },
+        shapecorr_eval::bench_store::BasisCache { dir: basis_cache },
         &mut print_pair_scores,
     )?;
     println!(
@@ -1126,7 +1132,10 @@ fn bench_p2p_command(
         samples,
         started.elapsed().as_secs_f64()
     );
-    print!("{}", shapecorr::bench_pointwise::pointwise_table(&results));
+    print!(
+        "{}",
+        shapecorr_eval::bench_pointwise::pointwise_table(&results)
+    );
     if let Some(path) = json_path {
         write_scores_json(path, &results)?;
     }
@@ -1134,7 +1143,7 @@ fn bench_p2p_command(
         let name = pairs
             .file_stem()
             .map_or(String::new(), |s| s.to_string_lossy().into_owned());
-        if !shapecorr::bench_pointwise::write_curves(path, &name, &results)? {
+        if !shapecorr_eval::bench_pointwise::write_curves(path, &name, &results)? {
             eprintln!(
                 "shapecorr: no font found, {} has no text (set SHAPECORR_FONT)",
                 path.with_extension("png").display()
@@ -1144,13 +1153,13 @@ fn bench_p2p_command(
     Ok(())
 }
 
-fn bench_all_command(p: &shapecorr::bench_all::AllParams, fresh: bool) -> Result<(), Error> {
+fn bench_all_command(p: &shapecorr_eval::bench_all::AllParams, fresh: bool) -> Result<(), Error> {
     let logs = p.work.join("logs");
     if fresh && logs.exists() {
         std::fs::remove_dir_all(&logs).map_err(|e| Error::file(&logs, e.to_string()))?;
     }
     let started = Instant::now();
-    let page = shapecorr::bench_all::run_all(p)?;
+    let page = shapecorr_eval::bench_all::run_all(p)?;
     println!(
         "{} written ({:.0} s); logs and eigenbasis cache in {}",
         page.display(),
@@ -1168,8 +1177,8 @@ fn bench_maps_command(
     samples: usize,
     json_path: Option<&Path>,
 ) -> Result<(), Error> {
-    let root = data.unwrap_or_else(shapecorr::datasets::default_data_root);
-    let results = shapecorr::bench_pointwise::bench_map_files(
+    let root = data.unwrap_or_else(shapecorr_eval::datasets::default_data_root);
+    let results = shapecorr_eval::bench_pointwise::bench_map_files(
         &root,
         pairs,
         maps,
@@ -1177,7 +1186,10 @@ fn bench_maps_command(
         limit,
         &mut print_pair_scores,
     )?;
-    print!("{}", shapecorr::bench_pointwise::pointwise_table(&results));
+    print!(
+        "{}",
+        shapecorr_eval::bench_pointwise::pointwise_table(&results)
+    );
     if let Some(path) = json_path {
         write_scores_json(path, &results)?;
     }

@@ -7,16 +7,16 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use shapecorr::bench_clouds::{
+use shapecorr::correspondence::{Correspondence, Params};
+use shapecorr::evaluation::score;
+use shapecorr::synth::{self, FigureKind, Proportions};
+use shapecorr::{Error, NoProgress, Shape};
+use shapecorr_eval::bench_clouds::{
     cloud_figure, cloud_seed, cloud_table, cloud_trials, largest_extent, sample_cloud,
     sample_surface, score_transferred, transfer_labels, CloudProtocol, CloudTrial, CLOUD_TO_CLOUD,
     MESH_TO_CLOUD,
 };
-use shapecorr::correspondence::{Correspondence, Params};
-use shapecorr::datasets::Pair;
-use shapecorr::evaluation::score;
-use shapecorr::synth::{self, FigureKind, Proportions};
-use shapecorr::{Error, NoProgress, Shape};
+use shapecorr_eval::datasets::Pair;
 
 /// A flat grid of `n x n` squares covering `[x0, x0 + side] x [0, side]` at z = 0.
 fn grid(x0: f64, side: f64, n: usize, offset: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
@@ -538,7 +538,7 @@ fn a_small_protocol_run_on_two_humanoid_poses() {
 #[test]
 #[ignore = "needs shared/data/faust; about 12 s in release"]
 fn faust_pair_quick_check() {
-    let root = shapecorr::datasets::default_data_root().join("faust");
+    let root = shapecorr_eval::datasets::default_data_root().join("faust");
     if !root.exists() {
         println!("no {}", root.display());
         return;

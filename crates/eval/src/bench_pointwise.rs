@@ -19,15 +19,17 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::bench_store::{BasisCache, ShapeStore};
-use crate::correspondence::{Correspondence, Params};
 use crate::datasets::{read_pairs, Dataset, Pair};
-use crate::descriptors::WksParams;
-use crate::eigen::EigenParams;
-use crate::evaluation::{pointwise_errors, ErrorSummary};
-use crate::pointwise::{truncated, PointwiseMap, PointwiseParams, Refinement, RegionConstraints};
-use crate::progress::NoProgress;
-use crate::shape::Shape;
-use crate::{Error, Result};
+use shapecorr::correspondence::{Correspondence, Params};
+use shapecorr::descriptors::WksParams;
+use shapecorr::eigen::EigenParams;
+use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
+use shapecorr::pointwise::{
+    truncated, PointwiseMap, PointwiseParams, Refinement, RegionConstraints,
+};
+use shapecorr::progress::NoProgress;
+use shapecorr::shape::Shape;
+use shapecorr::{Error, Result};
 
 /// Seed of the ground-truth sample.
 const SAMPLE_SEED: u64 = 0x9e0d;
@@ -58,7 +60,7 @@ pub fn methods(base: &PointwiseParams, region_params: &Params) -> Vec<(String, P
         ..descriptors_only.clone()
     };
     // Ovsjanikov et al. 2012's refinement, the last step of the framework the paper uses.
-    let icp = Refinement::Icp(crate::options::ICP_ITERATIONS);
+    let icp = Refinement::Icp(shapecorr::options::ICP_ITERATIONS);
     vec![
         ("wks".into(), wks_only.clone()),
         (
@@ -208,7 +210,7 @@ fn score_maps(
                 error,
                 error_mirrored,
                 seconds: *seconds,
-                curve: crate::evaluation::error_curve(best_errors, &curve_thresholds()),
+                curve: shapecorr::evaluation::error_curve(best_errors, &curve_thresholds()),
                 n_scored: best_errors.len(),
             }
         })
@@ -217,7 +219,7 @@ fn score_maps(
 
 /// The area of a shape in its own units (the unit-area scale of the errors).
 fn shape_area(shape: &Shape) -> Result<f64> {
-    Ok(crate::laplacian::Laplacian::new(shape)?.input_area)
+    Ok(shapecorr::laplacian::Laplacian::new(shape)?.input_area)
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -24,14 +24,14 @@ use crate::bench::{region_pair, PairResult};
 use crate::bench_clouds::{cloud_figure, cloud_table, cloud_trials, CloudProtocol, CloudTrial};
 use crate::bench_pointwise::{pointwise_pair, select_methods, write_curves, PairScores};
 use crate::bench_store::{BasisCache, ProgressBar, ResultLog, ShapeStore};
-use crate::correspondence::{Correspondence, Params, Timings};
 use crate::datasets::{discover, read_pairs, Dataset, Pair};
-use crate::eigen::EigenParams;
-use crate::pointwise::{PointwiseCorrespondence, PointwiseParams, PointwiseTimings};
-use crate::progress::NoProgress;
 use crate::reeb::{reeb_correspondence, ReebParams};
-use crate::shape::Shape;
-use crate::{Error, Result};
+use shapecorr::correspondence::{Correspondence, Params, Timings};
+use shapecorr::eigen::EigenParams;
+use shapecorr::pointwise::{PointwiseCorrespondence, PointwiseParams, PointwiseTimings};
+use shapecorr::progress::NoProgress;
+use shapecorr::shape::Shape;
+use shapecorr::{Error, Result};
 
 /// What `bench all` runs and where it writes.
 #[derive(Debug, Clone)]
@@ -186,7 +186,7 @@ pub const QUICK: &str = "quick";
 /// and `pairs/quick.txt` with FAUST's categories. Existing files are kept (they are
 /// deterministic).
 pub fn write_quick_dataset(root: &Path) -> Result<()> {
-    use crate::synth::{figure_poses, mirror_map, n_poses, FigureKind, Proportions};
+    use shapecorr::synth::{figure_poses, mirror_map, n_poses, FigureKind, Proportions};
     let folder = root.join(QUICK);
     let pairs_dir = root.join("pairs");
     for dir in [&folder, &pairs_dir] {
@@ -209,7 +209,7 @@ pub fn write_quick_dataset(root: &Path) -> Result<()> {
         for (pose, mesh) in meshes.iter().enumerate() {
             let path = folder.join(format!("body{body}_pose{pose}.ply"));
             if !path.exists() {
-                crate::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None)?;
+                shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None)?;
             }
         }
     }

@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use shapecorr::bench_store::{BasisCache, ResultLog, ShapeStore};
-use shapecorr::datasets::{discover, read_pairs, Dataset, Layout, Pair};
 use shapecorr::synth::{figure_poses, FigureKind, Proportions};
 use shapecorr::{EigenParams, Shape};
+use shapecorr_eval::bench_store::{BasisCache, ResultLog, ShapeStore};
+use shapecorr_eval::datasets::{discover, read_pairs, Dataset, Layout, Pair};
 
 fn temp(name: &str) -> PathBuf {
     let dir =
@@ -320,7 +320,7 @@ fn pointwise_bench_keeps_its_eigenbases_in_the_cache() {
     );
     let cache_dir = root.join("bases");
     let run = || {
-        shapecorr::bench_pointwise::bench_pointwise(
+        shapecorr_eval::bench_pointwise::bench_pointwise(
             &root,
             &pairs,
             &shapecorr::correspondence::Params::default(),

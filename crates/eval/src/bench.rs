@@ -10,12 +10,12 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::bench_store::{BasisCache, ShapeStore};
-use crate::correspondence::{Correspondence, Params, Timings};
 use crate::datasets::{read_pairs, Dataset, Pair};
-use crate::evaluation::{score_correspondence, RegionScores};
-use crate::pointwise::truncated;
-use crate::progress::NoProgress;
-use crate::Result;
+use shapecorr::correspondence::{Correspondence, Params, Timings};
+use shapecorr::evaluation::{score_correspondence, RegionScores};
+use shapecorr::pointwise::truncated;
+use shapecorr::progress::NoProgress;
+use shapecorr::Result;
 
 /// The outcome of one pair.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -58,10 +58,10 @@ pub fn bench_regions(
 /// A region method run on two shapes with their eigenbases: the paper's pipeline
 /// ([`Correspondence::from_bases`]) or a baseline.
 pub type RegionMethod<'a> = dyn Fn(
-        &crate::Shape,
-        &crate::Eigenbasis,
-        &crate::Shape,
-        &crate::Eigenbasis,
+        &shapecorr::Shape,
+        &shapecorr::Eigenbasis,
+        &shapecorr::Shape,
+        &shapecorr::Eigenbasis,
         &Params,
     ) -> Result<Correspondence>
     + 'a;
@@ -79,7 +79,7 @@ pub fn region_pair(
     let (a, b) = (store.get(&pair.source), store.get(&pair.target));
     let (basis_a, basis_b) = (store.basis(&pair.source), store.basis(&pair.target));
     let k = params.eigen.n_eigenpairs;
-    let cut = |basis: &crate::Eigenbasis| (basis.len() > k).then(|| truncated(basis, k));
+    let cut = |basis: &shapecorr::Eigenbasis| (basis.len() > k).then(|| truncated(basis, k));
     let (cut_a, cut_b) = (cut(&basis_a.basis), cut(&basis_b.basis));
     let t = Instant::now();
     let mut result = method(

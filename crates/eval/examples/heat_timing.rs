@@ -2,7 +2,7 @@
 //! solve per source, on the shapes given (default: FAUST tr_reg_000 and TOSCA david0 from
 //! ../shared/data, skipped when absent).
 //!
-//!     cargo run --release --example heat_timing [FILE ...]
+//!     cargo run --release -p shapecorr-eval --example heat_timing [FILE ...]
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -13,7 +13,7 @@ use shapecorr::Shape;
 fn main() -> shapecorr::Result<()> {
     let mut files: Vec<PathBuf> = std::env::args().skip(1).map(PathBuf::from).collect();
     if files.is_empty() {
-        let data = shapecorr::datasets::default_data_root();
+        let data = shapecorr_eval::datasets::default_data_root();
         files = ["faust/tr_reg_000.ply", "tosca/david0.ply"]
             .iter()
             .map(|f| data.join(f))

@@ -6,7 +6,7 @@
 //! ([`sample_cloud`]), match mesh A to cloud B ("mesh-to-cloud") or cloud A to cloud B
 //! ("cloud-to-cloud"), carry each cloud's regions back to its mesh through the nearest mesh
 //! vertex of every point ([`transfer_labels`]) and score against the meshes' ground truth
-//! with the region accuracy of [`crate::evaluation`], leaving out mesh vertices no point
+//! with the region accuracy of [`shapecorr::evaluation`], leaving out mesh vertices no point
 //! lands on ([`score_transferred`]). [`cloud_table`] and [`cloud_figure`] summarise.
 
 use std::collections::BTreeSet;
@@ -17,17 +17,17 @@ use std::time::Instant;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::correspondence::{Correspondence, Params};
 use crate::datasets::Pair;
-use crate::eigen::Eigenbasis;
-use crate::evaluation::region_accuracy;
-use crate::laplacian::Laplacian;
-use crate::neighbors::PointTree;
 use crate::plot::{line_chart_png, Chart, Rendered, Series};
-use crate::progress::NoProgress;
-use crate::shape::{Shape, ShapeKind, MIN_VERTICES};
-use crate::synth::{sample_points, FigureMesh};
-use crate::{Error, Result};
+use shapecorr::correspondence::{Correspondence, Params};
+use shapecorr::eigen::Eigenbasis;
+use shapecorr::evaluation::region_accuracy;
+use shapecorr::laplacian::Laplacian;
+use shapecorr::neighbors::PointTree;
+use shapecorr::progress::NoProgress;
+use shapecorr::shape::{Shape, ShapeKind, MIN_VERTICES};
+use shapecorr::synth::{sample_points, FigureMesh};
+use shapecorr::{Error, Result};
 
 /// Mode name: A stays a mesh, B is sampled as a cloud.
 pub const MESH_TO_CLOUD: &str = "mesh-to-cloud";
@@ -112,7 +112,7 @@ impl CloudProtocol {
 /// Width of a shape for the noise bound: the largest extent of its axis-aligned bounding box
 /// (a standing body's height). Smaller than [`Shape::width`], the box's diagonal.
 pub fn largest_extent(points: &[[f64; 3]]) -> f64 {
-    let (lo, hi) = crate::shape::bounding_box(points);
+    let (lo, hi) = shapecorr::shape::bounding_box(points);
     (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
 }
 
@@ -132,7 +132,7 @@ pub struct SurfaceSample {
 
 /// Samples `n_points` points uniformly by area on the surface of `mesh` (triangles chosen
 /// with probability proportional to area, uniform barycentric position inside; the
-/// sampler of [`crate::synth::sample_points`]), shifts every coordinate of every point by
+/// sampler of [`shapecorr::synth::sample_points`]), shifts every coordinate of every point by
 /// an independent uniform amount in `[-noise * width, noise * width]` with
 /// `width` = [`largest_extent`] of the mesh (paper: "shifting every vertex by up to 0%,
 /// 1% or 2% of the shape width in every direction"), and finds each noisy point's nearest

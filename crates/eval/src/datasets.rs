@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Error, Result};
+use shapecorr::{Error, Result};
 
 /// One line of a pair list: source, target, category.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -423,9 +423,9 @@ fn check_range(path: &Path, indices: &[u32], n: usize) -> Result<()> {
     }
 }
 
-/// The benchmark data root: `SHAPECORR_DATA`, else `../shared/data` next to the crate.
+/// The benchmark data root: `SHAPECORR_DATA`, else `../shared/data` next to the repository.
 pub fn default_data_root() -> PathBuf {
     std::env::var_os("SHAPECORR_DATA")
         .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"))
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
 }

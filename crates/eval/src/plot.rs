@@ -16,7 +16,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::{Error, Result};
+use shapecorr::{Error, Result};
 
 /// Width and height of the PNG, in pixels.
 pub const SIZE: (u32, u32) = (800, 600);

@@ -18,10 +18,10 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::datasets::Dataset;
-use crate::eigen::{EigenParams, Eigenbasis};
-use crate::geodesic::HeatGeodesics;
-use crate::shape::Shape;
-use crate::{Error, Result};
+use shapecorr::eigen::{EigenParams, Eigenbasis};
+use shapecorr::geodesic::HeatGeodesics;
+use shapecorr::shape::Shape;
+use shapecorr::{Error, Result};
 
 /// Version of the cache file format and of the eigensolver's output: bump it when either
 /// changes, so old cache files are not used.

@@ -315,7 +315,8 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
                 > 0.0
         );
         assert_eq!(result["regions_b"].as_array().unwrap().len(), n_b);
-        let map = shapecorr::bench_pointwise::read_map(&out_dir.join("map_b_to_a.txt")).unwrap();
+        let map =
+            shapecorr_eval::bench_pointwise::read_map(&out_dir.join("map_b_to_a.txt")).unwrap();
         assert_eq!(map.len(), n_b);
         assert!(map.iter().all(|&v| (v as usize) < n_a));
         for ply in [

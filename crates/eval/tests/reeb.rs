@@ -5,12 +5,12 @@
 use shapecorr::correspondence::Params;
 use shapecorr::evaluation::score_correspondence;
 use shapecorr::graph::ShapeGraph;
-use shapecorr::reeb::{
+use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec};
+use shapecorr::{EigenParams, Eigenbasis, Error, Shape};
+use shapecorr_eval::reeb::{
     hks_function, level_boundaries, level_of, reeb_correspondence, reeb_graph, shape_reeb_graph,
     ReebParams,
 };
-use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec};
-use shapecorr::{EigenParams, Eigenbasis, Error, Shape};
 
 fn figure(kind: FigureKind, pose: usize, vertices: usize) -> FigureMesh {
     synth::figure(&FigureSpec {
