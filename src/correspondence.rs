@@ -1,24 +1,25 @@
 //! The whole job behind one call: two shapes in, their regions and the region
-//! correspondence out (DESIGN.md section 1, steps 1-12 and 14).
+//! correspondence out (docs/design.md, steps 1-12 and 14).
 //!
 //! `Correspondence::compute(&a, &b, &params, &mut progress)` runs: eigenbasis and HKS of each
 //! shape -> rank alignment and joint segmentation over a range of k, with the two shape
-//! graphs ([`crate::segmentation`]) -> spectral graph matching into a symmetric region
-//! correspondence ([`crate::matching`]) -> symmetry breaking into a one-to-one
-//! correspondence ([`crate::symmetry`]). Every per-vertex output is indexed by the caller's
+//! graphs ([`crate::regions::segmentation`]) -> spectral graph matching into a symmetric region
+//! correspondence ([`crate::regions::matching`]) -> symmetry breaking into a one-to-one
+//! correspondence ([`crate::regions::symmetry`]). Every per-vertex output is indexed by the caller's
 //! vertices.
 
 use std::time::Instant;
 
-use crate::descriptors::{hks, HksParams};
-use crate::eigen::{EigenParams, Eigenbasis};
+use crate::colors::{palette, region_colors, UNMATCHED_COLOR};
 use crate::geodesic::region_distance_matrix;
-use crate::graph::ShapeGraph;
-use crate::matching::{match_graphs, MatchingParams};
 use crate::progress::{check, NoProgress, Progress, Stage};
-use crate::segmentation::{segment_pair_with_progress, KCandidate, SegmentationParams};
+use crate::regions::graph::ShapeGraph;
+use crate::regions::matching::{match_graphs, MatchingParams};
+use crate::regions::segmentation::{segment_pair_with_progress, KCandidate, SegmentationParams};
+use crate::regions::symmetry::{one_to_one, SymmetryParams};
 use crate::shape::Shape;
-use crate::symmetry::{one_to_one, SymmetryParams};
+use crate::spectral::descriptors::{hks, HksParams};
+use crate::spectral::eigen::{EigenParams, Eigenbasis};
 use crate::Result;
 
 /// Every parameter of the method, with the documented defaults. The command line, the C API
@@ -300,8 +301,8 @@ impl SelfScore {
 }
 
 fn self_score(
-    seg: &crate::segmentation::JointSegmentation,
-    m: &crate::matching::GraphMatching,
+    seg: &crate::regions::segmentation::JointSegmentation,
+    m: &crate::regions::matching::GraphMatching,
     basis_a: &Eigenbasis,
     basis_b: &Eigenbasis,
 ) -> SelfScore {
@@ -355,8 +356,8 @@ fn segment_and_match(
     timings: &mut Timings,
     progress: &mut dyn Progress,
 ) -> Result<(
-    crate::segmentation::JointSegmentation,
-    crate::matching::GraphMatching,
+    crate::regions::segmentation::JointSegmentation,
+    crate::regions::matching::GraphMatching,
 )> {
     check(progress, Stage::Descriptors, 0.0)?;
     let t = Instant::now();
@@ -394,7 +395,7 @@ fn segment_and_match(
     Ok((segmentation, matching))
 }
 
-/// Symmetric regions of one shape, found by matching the shape to itself (DESIGN step 14).
+/// Symmetric regions of one shape, found by matching the shape to itself (docs/design.md, step 14).
 #[derive(Debug, Clone)]
 pub struct Symmetry {
     /// The shape graph; `graph.labels` is the region of every vertex.
@@ -500,81 +501,4 @@ pub fn one_to_one_matches(
 /// Convenience: [`Correspondence::compute`] with default parameters and no progress.
 pub fn correspond(a: &Shape, b: &Shape) -> Result<Correspondence> {
     Correspondence::compute(a, b, &Params::default(), &mut NoProgress)
-}
-
-/// Colours for regions: matched regions share a colour, unmatched regions are dark grey.
-/// `pairs` are the matches to colour by; regions connected through matches (a symmetric
-/// group) share one colour. Returns per-vertex RGB for A and B.
-pub fn region_colors(
-    labels_a: &[u32],
-    n_a: usize,
-    labels_b: &[u32],
-    n_b: usize,
-    pairs: &[(u32, u32)],
-) -> (Vec<[u8; 3]>, Vec<[u8; 3]>) {
-    // Union-find over A's regions (0..n_a) and B's regions (n_a..n_a+n_b).
-    let mut sets = crate::shape::DisjointSets::new(n_a + n_b);
-    for &(i, j) in pairs {
-        sets.union(i as usize, n_a + j as usize);
-    }
-    let mut matched = vec![false; n_a + n_b];
-    for &(i, j) in pairs {
-        matched[i as usize] = true;
-        matched[n_a + j as usize] = true;
-    }
-    // Number the groups in order of their smallest member, so colours are deterministic.
-    let mut group_index = std::collections::BTreeMap::new();
-    for (node, &is_matched) in matched.iter().enumerate() {
-        if is_matched {
-            let root = sets.find(node);
-            let next = group_index.len();
-            group_index.entry(root).or_insert(next);
-        }
-    }
-    let colour_of = |node: usize, sets: &mut crate::shape::DisjointSets| -> [u8; 3] {
-        if matched[node] {
-            palette(group_index[&sets.find(node)])
-        } else {
-            UNMATCHED_COLOR
-        }
-    };
-    let region_colour_a: Vec<[u8; 3]> = (0..n_a).map(|r| colour_of(r, &mut sets)).collect();
-    let region_colour_b: Vec<[u8; 3]> = (0..n_b).map(|r| colour_of(n_a + r, &mut sets)).collect();
-    (
-        labels_a
-            .iter()
-            .map(|&r| region_colour_a[r as usize])
-            .collect(),
-        labels_b
-            .iter()
-            .map(|&r| region_colour_b[r as usize])
-            .collect(),
-    )
-}
-
-/// Colour of unmatched regions (DESIGN section 3: dark grey).
-pub const UNMATCHED_COLOR: [u8; 3] = [64, 64, 64];
-
-/// The i-th of a sequence of well-separated bright colours (hues stepped by the golden
-/// angle, alternating saturation and value so neighbours in the sequence differ).
-pub fn palette(i: usize) -> [u8; 3] {
-    let hue = (i as f64 * 0.618_033_988_749_895).fract();
-    let (s, v) = match i % 3 {
-        0 => (0.75, 0.95),
-        1 => (0.55, 0.85),
-        _ => (0.9, 0.75),
-    };
-    let h = hue * 6.0;
-    let c = v * s;
-    let x = c * (1.0 - ((h % 2.0) - 1.0).abs());
-    let (r, g, b) = match h as u32 {
-        0 => (c, x, 0.0),
-        1 => (x, c, 0.0),
-        2 => (0.0, c, x),
-        3 => (0.0, x, c),
-        4 => (x, 0.0, c),
-        _ => (c, 0.0, x),
-    };
-    let m = v - c;
-    [r, g, b].map(|t| ((t + m) * 255.0).round() as u8)
 }

@@ -1,4 +1,4 @@
-//! Scores of a region correspondence against a ground-truth vertex map (DESIGN.md section 2,
+//! Scores of a region correspondence against a ground-truth vertex map (docs/design.md, step 15,
 //! paper section 6.2).
 //!
 //! Ground truth is a list of vertex pairs `(vertex of A, vertex of B)` (every vertex for

@@ -1,5 +1,5 @@
 //! Distances along the surface, and the region-to-region distances that symmetry breaking
-//! compares (DESIGN section 4, "One-to-one from symmetric matches").
+//! compares (docs/design.md, step 12).
 //!
 //! These are **edge-graph** distances: Dijkstra over the mesh edges (or a point cloud's
 //! 6-NN graph) with Euclidean edge lengths. They overestimate the true geodesic distance by
@@ -13,9 +13,9 @@ use std::collections::BinaryHeap;
 use faer::Mat;
 use rayon::prelude::*;
 
-use crate::laplacian::{heron_area, triangulation, Laplacian};
 use crate::shape::DisjointSets;
-use crate::sparse::SparseCholesky;
+use crate::spectral::laplacian::{heron_area, triangulation, Laplacian};
+use crate::spectral::sparse::SparseCholesky;
 use crate::{Error, Result, Shape};
 
 /// Stands in for the distance between two regions that cannot reach each other (different
@@ -178,14 +178,14 @@ pub fn edge_graph_distances(shape: &Shape, sources: &[u32], scale: f64) -> Vec<f
     EdgeGraph::new(shape, scale).distances(sources)
 }
 
-/// Symmetric region-to-region distances (DESIGN section 4):
+/// Symmetric region-to-region distances (docs/design.md, step 12):
 /// `D[R,Q] = 0.5 * (mean_Q d_R + mean_R d_Q)`, `D[R,R] = 0`, where `d_R` is the edge-graph
 /// distance from all vertices of region `R` (one multi-source solve per region, in parallel)
 /// and `mean_Q` the `mass`-weighted mean over the vertices of `Q` (unweighted for a region
 /// whose mass is zero).
 ///
 /// `mass` and `labels` are per input vertex (e.g. [`crate::Eigenbasis::mass`] and
-/// [`crate::graph::ShapeGraph::labels`]); `scale` multiplies the edge lengths (pass
+/// [`crate::regions::graph::ShapeGraph::labels`]); `scale` multiplies the edge lengths (pass
 /// `1 / sqrt(input_area)` for the unit-area shape). A vertex that cannot reach `R` (another
 /// connected piece) counts at the large finite distance [`UNREACHABLE_FACTOR`] times the
 /// largest finite vertex distance of all solves; so does an empty region (no vertices) for

@@ -3,17 +3,27 @@
 //! Region-level correspondences between 3D shapes (triangle meshes and point clouds), after
 //! Kleiman and Ovsjanikov, "Robust Structure-based Shape Correspondence".
 //!
-//! The modules follow the data flow: [`io`] (files) -> [`shape`] (validated shape) ->
-//! [`laplacian`] -> [`eigen`] (eigenbasis) -> [`descriptors`] (HKS, WKS) ->
-//! [`segmentation`] (joint clusters, [`graph`] shape graphs) -> [`matching`] (symmetric
-//! region matches) -> [`symmetry`] (one-to-one, with [`geodesic`] region distances).
-//! [`correspondence`] runs the whole job; [`evaluation`], [`datasets`] and [`bench`](mod@bench) score
-//! it; [`synth`] makes articulated test figures with known ground truth; [`progress`]
-//! carries progress reports and cancellation.
+//! The modules follow the data flow (the method: `docs/design.md`; why each default is what
+//! it is: `docs/decisions.md`):
+//!
+//! | stage | module |
+//! |---|---|
+//! | shape in: files, validation, neighbours | [`shape`] ([`shape::io`], [`shape::neighbors`]) |
+//! | Laplacian, eigenbasis, HKS/WKS | [`spectral`] ([`laplacian`](spectral::laplacian), [`eigen`](spectral::eigen), [`descriptors`](spectral::descriptors)) |
+//! | joint segmentation, shape graphs, graph matching, one-to-one | [`regions`] ([`segmentation`](regions::segmentation), [`graph`](regions::graph), [`matching`](regions::matching), [`symmetry`](regions::symmetry)) |
+//! | distances on the surface (edge graph, heat method) | [`geodesic`] |
+//! | point-to-point maps | [`maps`] ([`fmap`](maps::fmap), [`pointwise`](maps::pointwise)) |
+//! | the whole job | [`correspondence`] ([`Correspondence`], [`Symmetry`]), [`maps::pointwise`] ([`PointwiseCorrespondence`]) |
+//! | scores against ground truth | [`evaluation`] |
+//! | front ends | [`options`] (the one table of named options), [`ffi`] (the C API), [`colors`] |
+//! | test figures with exact ground truth | [`synth`] |
+//!
+//! [`progress`] carries progress reports and cancellation; [`Error`] is the one error type.
+//! The benchmark harness is the workspace crate `shapecorr-eval` (`crates/eval`), the
+//! command line `shapecorr-cli` (`crates/cli`).
 //!
 //! ```no_run
-//! use shapecorr::correspondence::{Correspondence, Params};
-//! use shapecorr::{NoProgress, Shape};
+//! use shapecorr::{Correspondence, NoProgress, Params, Shape};
 //!
 //! # fn main() -> shapecorr::Result<()> {
 //! let a = Shape::read("a.ply".as_ref(), false)?; // validated, input order kept
@@ -34,31 +44,23 @@
 // with `partial_cmp` would hide that.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod colors;
 pub mod correspondence;
-pub mod descriptors;
-pub mod eigen;
 pub mod error;
 pub mod evaluation;
 pub mod ffi;
-pub mod fmap;
 pub mod geodesic;
-pub mod graph;
-pub mod io;
-pub mod laplacian;
-pub mod matching;
-pub mod neighbors;
+pub mod maps;
 pub mod options;
-pub mod pointwise;
 pub mod progress;
-pub mod segmentation;
+pub mod regions;
 pub mod shape;
-mod sparse;
-pub mod symmetry;
+pub mod spectral;
 pub mod synth;
 
-pub use descriptors::{hks, wks, HksParams, WksParams};
-pub use eigen::{EigenParams, Eigenbasis};
+pub use correspondence::{Correspondence, Params, Symmetry};
 pub use error::{Error, Result};
-pub use laplacian::Laplacian;
+pub use maps::pointwise::{PointwiseCorrespondence, PointwiseParams};
 pub use progress::{NoProgress, Progress, Stage};
 pub use shape::{Shape, ShapeKind, Warning};
+pub use spectral::eigen::{EigenParams, Eigenbasis};

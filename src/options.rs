@@ -12,8 +12,8 @@
 //! [`PointwiseParams::validate`]'s.
 
 use crate::correspondence::Params;
-use crate::fmap::ZoomOutParams;
-use crate::pointwise::{PointwiseParams, Refinement, RegionConstraints};
+use crate::maps::fmap::ZoomOutParams;
+use crate::maps::pointwise::{PointwiseParams, Refinement, RegionConstraints};
 use crate::{Error, Result};
 
 /// The type of an option's value.
@@ -582,7 +582,7 @@ impl Options {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::descriptors::WksParams;
+    use crate::spectral::descriptors::WksParams;
 
     #[test]
     fn every_option_reads_back_what_was_set() {

@@ -196,7 +196,7 @@ fn symmetry_detection_groups_the_limbs_of_a_star() {
     // left the others dark grey): every region of the limb group has the group's colour.
     let colors = symmetry.vertex_colors();
     let group_colour = colors[tip];
-    assert_ne!(group_colour, shapecorr::correspondence::UNMATCHED_COLOR);
+    assert_ne!(group_colour, shapecorr::colors::UNMATCHED_COLOR);
     for (v, &region) in symmetry.graph.labels.iter().enumerate() {
         if group.contains(&region) {
             assert_eq!(colors[v], group_colour, "vertex {v} in region {region}");

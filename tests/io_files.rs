@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use shapecorr::io::{
+use shapecorr::shape::io::{
     encode_ply, parse_obj, parse_off, parse_ply, parse_shape, parse_xyz, read_obj, read_off,
     read_ply, read_shape, read_xyz, write_ply, write_ply_ascii, PlyEncoding, RawShape,
 };

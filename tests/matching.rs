@@ -8,8 +8,8 @@ use std::time::Instant;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use shapecorr::graph::ShapeGraph;
-use shapecorr::matching::{
+use shapecorr::regions::graph::ShapeGraph;
+use shapecorr::regions::matching::{
     distance_histograms, leading_eigenvector, match_graphs, symmetry_groups, unary_costs, Affinity,
     DistanceTerm, GraphMatching, MatchingParams,
 };

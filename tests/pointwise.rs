@@ -8,9 +8,9 @@ mod common;
 use faer::Mat;
 use shapecorr::correspondence::Params;
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
-use shapecorr::fmap::{fmap_to_p2p, nearest_rows, p2p_to_fmap, zoomout, ZoomOutParams};
 use shapecorr::geodesic::HeatGeodesics;
-use shapecorr::pointwise::{
+use shapecorr::maps::fmap::{fmap_to_p2p, nearest_rows, p2p_to_fmap, zoomout, ZoomOutParams};
+use shapecorr::maps::pointwise::{
     PointwiseCorrespondence, PointwiseMap, PointwiseParams, Refinement, RegionConstraints,
 };
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
@@ -216,9 +216,9 @@ fn two_poses_are_mapped_accurately_and_refinement_helps() {
     let basis_b = basis(&b, 100);
     let regions = shapecorr::correspondence::Correspondence::from_bases(
         &a,
-        &shapecorr::pointwise::truncated(&basis_a, params.eigen.n_eigenpairs),
+        &shapecorr::maps::pointwise::truncated(&basis_a, params.eigen.n_eigenpairs),
         &b,
-        &shapecorr::pointwise::truncated(&basis_b, params.eigen.n_eigenpairs),
+        &shapecorr::maps::pointwise::truncated(&basis_b, params.eigen.n_eigenpairs),
         &params,
         &mut NoProgress,
     )
@@ -402,14 +402,14 @@ fn orientation_score_tells_a_map_from_its_mirror_image() {
     let b = Shape::mesh(posed.vertices.clone(), &posed.triangles).unwrap();
     let identity: Vec<u32> = (0..b.n_vertices() as u32).collect();
     let mirror = synth::mirror_map(&rest);
-    let kept = shapecorr::pointwise::orientation_score(&a, &b, &identity).unwrap();
-    let mirrored = shapecorr::pointwise::orientation_score(&a, &b, &mirror).unwrap();
+    let kept = shapecorr::maps::pointwise::orientation_score(&a, &b, &identity).unwrap();
+    let mirrored = shapecorr::maps::pointwise::orientation_score(&a, &b, &mirror).unwrap();
     println!("orientation kept: identity {kept:.3}, mirror {mirrored:.3}");
     assert!(kept > 0.95 && mirrored < 0.05, "{kept} {mirrored}");
     // A point cloud has no orientation.
     let cloud = Shape::point_cloud(posed.vertices).unwrap();
     assert_eq!(
-        shapecorr::pointwise::orientation_score(&a, &cloud, &identity),
+        shapecorr::maps::pointwise::orientation_score(&a, &cloud, &identity),
         None
     );
 }
@@ -435,7 +435,7 @@ fn orientation_operators_commute_with_a_direct_isometry_and_anticommute_with_a_m
     let functions =
         |shape: &Shape| Mat::from_fn(shape.n_vertices(), 3, |v, c| shape.vertices()[v][c]);
     let ops = |shape: &Shape, basis: &Eigenbasis, f: &Mat<f64>| {
-        shapecorr::fmap::orientation_operators(
+        shapecorr::maps::fmap::orientation_operators(
             basis.vectors.as_ref(),
             k,
             shape.triangles(),
@@ -499,7 +499,7 @@ fn fmap_energy(
     coef: (&Mat<f64>, &Mat<f64>),
     values: (&[f64], &[f64]),
     laplacian_weight: f64,
-    terms: &[shapecorr::fmap::Commutativity<'_>],
+    terms: &[shapecorr::maps::fmap::Commutativity<'_>],
 ) -> f64 {
     let (k2, k1) = (c.nrows(), c.ncols());
     let mut e = (c * coef.0 - coef.1).norm_l2().powi(2);
@@ -523,7 +523,7 @@ fn fmap_energy(
 
 #[test]
 fn the_commuting_solver_reaches_the_minimum_of_its_energy() {
-    use shapecorr::fmap::{solve_fmap, solve_fmap_commuting, Commutativity};
+    use shapecorr::maps::fmap::{solve_fmap, solve_fmap_commuting, Commutativity};
     let (k1, k2, d) = (6, 5, 4);
     // Fixed pseudo-random inputs.
     let mut state = 0x1234_5678_u64;

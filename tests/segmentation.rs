@@ -1,4 +1,4 @@
-//! Joint segmentation (`shapecorr::segmentation`): rank alignment, weighted joint k-means,
+//! Joint segmentation (`shapecorr::regions::segmentation`): rank alignment, weighted joint k-means,
 //! shape graphs on generated figures, the choice of k on two poses, and (ignored, needs
 //! the FAUST data) the figures on real scans.
 
@@ -12,14 +12,15 @@ use common::permutation;
 use faer::Mat;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use shapecorr::graph::ShapeGraph;
-use shapecorr::segmentation::{
+use shapecorr::regions::graph::ShapeGraph;
+use shapecorr::regions::segmentation::{
     joint_kmeans, joint_kmeans_with, rank_align, segment_pair, shape_graph, shape_graph_with,
     GraphParams, JointClustering, KMeansMetric, KMeansParams, KTieBreak, RegionExpansion,
     SegmentationParams,
 };
+use shapecorr::spectral::descriptors::{hks, HksParams};
 use shapecorr::synth::{figure, figure_poses, FigureKind, FigureSpec, Proportions};
-use shapecorr::{hks, EigenParams, Eigenbasis, HksParams, Shape};
+use shapecorr::{EigenParams, Eigenbasis, Shape};
 
 // ---------------------------------------------------------------------------------------
 // Helpers

@@ -5,10 +5,10 @@ mod common;
 
 use common::{icosphere, permutation, rel};
 use faer::Mat;
-use shapecorr::eigen::eigenpairs;
-use shapecorr::{
-    hks, wks, EigenParams, Eigenbasis, HksParams, Laplacian, NoProgress, Shape, WksParams,
-};
+use shapecorr::spectral::descriptors::{hks, wks, HksParams, WksParams};
+use shapecorr::spectral::eigen::eigenpairs;
+use shapecorr::spectral::laplacian::Laplacian;
+use shapecorr::{EigenParams, Eigenbasis, NoProgress, Shape};
 
 fn sphere(levels: u32) -> Shape {
     let (v, f) = icosphere(levels);

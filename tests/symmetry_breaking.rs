@@ -1,6 +1,6 @@
 //! Symmetry breaking (paper, section 5.2; DESIGN section 4): region distances on surfaces
 //! (`shapecorr::geodesic`) and one-to-one region matches from symmetric ones
-//! (`shapecorr::symmetry`), on constructed layouts whose right answers are known, on
+//! (`shapecorr::regions::symmetry`), on constructed layouts whose right answers are known, on
 //! generated figures, and (timings) on the benchmark shapes when present.
 
 use std::path::{Path, PathBuf};
@@ -13,7 +13,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use shapecorr::geodesic::{edge_graph_distances, region_distance_matrix};
-use shapecorr::symmetry::{
+use shapecorr::regions::symmetry::{
     bipartite_groups, distortion_energy, greedy_one_to_one, one_to_one, OneToOneMethod,
     SymmetryParams,
 };

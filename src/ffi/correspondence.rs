@@ -10,7 +10,7 @@ use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
 use crate::correspondence::Correspondence;
-use crate::graph::ShapeGraph;
+use crate::regions::graph::ShapeGraph;
 
 /// The result of `sc_match`. Immutable: one handle may be read from several threads at
 /// once. Free it with `sc_correspondence_free`.

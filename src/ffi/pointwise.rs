@@ -10,7 +10,7 @@ use super::correspondence::{ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
-use crate::pointwise::PointwiseCorrespondence;
+use crate::maps::pointwise::PointwiseCorrespondence;
 
 /// The result of `sc_pointwise_map`: a vertex map from B to A, the functional map from A to
 /// B and the region correspondence it was built on. Immutable: one handle may be read from
@@ -231,10 +231,10 @@ pub unsafe extern "C" fn sc_pointwise_seconds(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::maps::pointwise::RegionConstraints;
     use crate::options::{
         P2P_REFINEMENT_ICP, P2P_REFINEMENT_NONE, P2P_REFINEMENT_ZOOMOUT, P2P_REGIONS,
     };
-    use crate::pointwise::RegionConstraints;
 
     #[test]
     fn header_choice_constants_match_the_options() {

@@ -337,7 +337,7 @@ mod tests;
 /// reflection. Poses share the rest pose's vertex order, so the map serves them all, e.g.
 /// for flip-tolerant scores.
 pub fn mirror_map(rest: &FigureMesh) -> Vec<u32> {
-    let tree = crate::neighbors::PointTree::new(&rest.vertices);
+    let tree = crate::shape::neighbors::PointTree::new(&rest.vertices);
     rest.vertices
         .iter()
         .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)

@@ -7,17 +7,19 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use serde_json::json;
-use shapecorr::correspondence::{region_colors, Correspondence, Params, Symmetry};
+use shapecorr::colors::{coordinate_colors, region_colors};
+use shapecorr::correspondence::{Correspondence, Params, Symmetry};
 use shapecorr::evaluation::score_correspondence;
-use shapecorr::fmap::ZoomOutParams;
-use shapecorr::graph::ShapeGraph;
-use shapecorr::pointwise::{
-    coordinate_colors, truncated, PointwiseCorrespondence, PointwiseMap, PointwiseParams,
-    Refinement, RegionConstraints,
+use shapecorr::maps::fmap::ZoomOutParams;
+use shapecorr::maps::pointwise::{
+    truncated, PointwiseCorrespondence, PointwiseMap, PointwiseParams, Refinement,
+    RegionConstraints,
 };
 use shapecorr::progress::{Progress, Stage};
+use shapecorr::regions::graph::ShapeGraph;
+use shapecorr::spectral::laplacian::Laplacian;
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
-use shapecorr::{EigenParams, Eigenbasis, Error, Laplacian, Shape, ShapeKind};
+use shapecorr::{EigenParams, Eigenbasis, Error, Shape, ShapeKind};
 use shapecorr_eval::bench_pointwise::PairScores;
 
 #[derive(Parser)]
@@ -672,7 +674,7 @@ fn eigen(
     let t_laplacian = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     let (values, vectors) =
-        shapecorr::eigen::eigenpairs(&laplacian, &params, &mut shapecorr::NoProgress)?;
+        shapecorr::spectral::eigen::eigenpairs(&laplacian, &params, &mut shapecorr::NoProgress)?;
     let t_eigen = t2.elapsed().as_secs_f64();
     let peak = peak_memory_mib();
     if let Some(dir) = export {
@@ -775,7 +777,7 @@ fn synth_command(
     })?;
     match points {
         None => {
-            shapecorr::io::write_ply(out, &mesh.vertices, &mesh.triangles, None)?;
+            shapecorr::shape::io::write_ply(out, &mesh.vertices, &mesh.triangles, None)?;
             println!(
                 "{}: {} vertices, {} triangles",
                 out.display(),
@@ -785,7 +787,7 @@ fn synth_command(
         }
         Some(n) => {
             let cloud = synth::sample_points(&mesh, n, noise, seed)?;
-            shapecorr::io::write_ply(out, &cloud.points, &[], None)?;
+            shapecorr::shape::io::write_ply(out, &cloud.points, &[], None)?;
             let gt_path = out.with_extension("gt.txt");
             let text: String = cloud
                 .source_vertex
@@ -882,13 +884,13 @@ fn write_colored(out: &Path, a: &Shape, b: &Shape, result: &Correspondence) -> R
         result.graph_b.n_nodes(),
         pairs,
     );
-    shapecorr::io::write_ply(
+    shapecorr::shape::io::write_ply(
         &out.join("a_regions.ply"),
         a.vertices(),
         a.triangles(),
         Some(&colors_a),
     )?;
-    shapecorr::io::write_ply(
+    shapecorr::shape::io::write_ply(
         &out.join("b_regions.ply"),
         b.vertices(),
         b.triangles(),
@@ -934,7 +936,7 @@ fn symmetry_command(a: &Path, out: &Path, points: bool, params: &Params) -> Resu
     end_progress_line();
     let symmetry = symmetry?;
     let colors = symmetry.vertex_colors();
-    shapecorr::io::write_ply(
+    shapecorr::shape::io::write_ply(
         &out.join("a_symmetry.ply"),
         shape.vertices(),
         shape.triangles(),
@@ -1321,13 +1323,13 @@ fn demo(out: &Path, vertices: usize) -> Result<(), Error> {
 fn write_map_colors(out: &Path, a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Result<(), Error> {
     let colors_a = coordinate_colors(a.vertices());
     let colors_b: Vec<[u8; 3]> = p2p_ba.iter().map(|&v| colors_a[v as usize]).collect();
-    shapecorr::io::write_ply(
+    shapecorr::shape::io::write_ply(
         &out.join("a_colors.ply"),
         a.vertices(),
         a.triangles(),
         Some(&colors_a),
     )?;
-    shapecorr::io::write_ply(
+    shapecorr::shape::io::write_ply(
         &out.join("b_mapped.ply"),
         b.vertices(),
         b.triangles(),

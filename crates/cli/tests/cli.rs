@@ -195,7 +195,7 @@ fn match_and_symmetry_write_their_results() {
     assert_eq!(result["version"], env!("CARGO_PKG_VERSION"));
     // The coloured shapes read back with one colour per vertex.
     for name in ["a_regions.ply", "b_regions.ply"] {
-        let raw = shapecorr::io::read_shape(&out_dir.join(name)).unwrap();
+        let raw = shapecorr::shape::io::read_shape(&out_dir.join(name)).unwrap();
         assert_eq!(
             raw.vertices.len(),
             if name.starts_with('a') {

@@ -13,7 +13,7 @@ use crate::bench_store::{BasisCache, ShapeStore};
 use crate::datasets::{read_pairs, Dataset, Pair};
 use shapecorr::correspondence::{Correspondence, Params, Timings};
 use shapecorr::evaluation::{score_correspondence, RegionScores};
-use shapecorr::pointwise::truncated;
+use shapecorr::maps::pointwise::truncated;
 use shapecorr::progress::NoProgress;
 use shapecorr::Result;
 

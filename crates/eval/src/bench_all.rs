@@ -27,10 +27,10 @@ use crate::bench_store::{BasisCache, ProgressBar, ResultLog, ShapeStore};
 use crate::datasets::{discover, read_pairs, Dataset, Pair};
 use crate::reeb::{reeb_correspondence, ReebParams};
 use shapecorr::correspondence::{Correspondence, Params, Timings};
-use shapecorr::eigen::EigenParams;
-use shapecorr::pointwise::{PointwiseCorrespondence, PointwiseParams, PointwiseTimings};
+use shapecorr::maps::pointwise::{PointwiseCorrespondence, PointwiseParams, PointwiseTimings};
 use shapecorr::progress::NoProgress;
 use shapecorr::shape::Shape;
+use shapecorr::spectral::eigen::EigenParams;
 use shapecorr::{Error, Result};
 
 /// What `bench all` runs and where it writes.
@@ -209,7 +209,7 @@ pub fn write_quick_dataset(root: &Path) -> Result<()> {
         for (pose, mesh) in meshes.iter().enumerate() {
             let path = folder.join(format!("body{body}_pose{pose}.ply"));
             if !path.exists() {
-                shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None)?;
+                shapecorr::shape::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None)?;
             }
         }
     }

@@ -20,12 +20,12 @@ use rand_chacha::ChaCha8Rng;
 use crate::datasets::Pair;
 use crate::plot::{line_chart_png, Chart, Rendered, Series};
 use shapecorr::correspondence::{Correspondence, Params};
-use shapecorr::eigen::Eigenbasis;
 use shapecorr::evaluation::region_accuracy;
-use shapecorr::laplacian::Laplacian;
-use shapecorr::neighbors::PointTree;
 use shapecorr::progress::NoProgress;
+use shapecorr::shape::neighbors::PointTree;
 use shapecorr::shape::{Shape, ShapeKind, MIN_VERTICES};
+use shapecorr::spectral::eigen::Eigenbasis;
+use shapecorr::spectral::laplacian::Laplacian;
 use shapecorr::synth::{sample_points, FigureMesh};
 use shapecorr::{Error, Result};
 

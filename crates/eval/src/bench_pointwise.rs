@@ -21,14 +21,14 @@ use serde::{Deserialize, Serialize};
 use crate::bench_store::{BasisCache, ShapeStore};
 use crate::datasets::{read_pairs, Dataset, Pair};
 use shapecorr::correspondence::{Correspondence, Params};
-use shapecorr::descriptors::WksParams;
-use shapecorr::eigen::EigenParams;
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
-use shapecorr::pointwise::{
+use shapecorr::maps::pointwise::{
     truncated, PointwiseMap, PointwiseParams, Refinement, RegionConstraints,
 };
 use shapecorr::progress::NoProgress;
 use shapecorr::shape::Shape;
+use shapecorr::spectral::descriptors::WksParams;
+use shapecorr::spectral::eigen::EigenParams;
 use shapecorr::{Error, Result};
 
 /// Seed of the ground-truth sample.
@@ -219,7 +219,7 @@ fn score_maps(
 
 /// The area of a shape in its own units (the unit-area scale of the errors).
 fn shape_area(shape: &Shape) -> Result<f64> {
-    Ok(shapecorr::laplacian::Laplacian::new(shape)?.input_area)
+    Ok(shapecorr::spectral::laplacian::Laplacian::new(shape)?.input_area)
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -18,9 +18,9 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::datasets::Dataset;
-use shapecorr::eigen::{EigenParams, Eigenbasis};
 use shapecorr::geodesic::HeatGeodesics;
 use shapecorr::shape::Shape;
+use shapecorr::spectral::eigen::{EigenParams, Eigenbasis};
 use shapecorr::{Error, Result};
 
 /// Version of the cache file format and of the eigensolver's output: bump it when either

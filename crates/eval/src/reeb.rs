@@ -1,8 +1,8 @@
 //! The Reeb-graph baseline of the paper's Table 1 (section 6.2, last column): the shape
 //! graph replaced by a discretised Reeb graph of one scalar function, the heat kernel
 //! signature at a single time, matched with the same graph matcher
-//! ([`shapecorr::matching::match_graphs`]) and the same one-to-one step
-//! ([`shapecorr::symmetry::one_to_one`]) as the main method.
+//! ([`shapecorr::regions::matching::match_graphs`]) and the same one-to-one step
+//! ([`shapecorr::regions::symmetry::one_to_one`]) as the main method.
 //!
 //! Construction ([`reeb_graph`]), the usual discrete Reeb graph (Mapper without overlap):
 //! 1. `f` = HKS at time `t` ([`ReebParams::hks_time`]) on the unit-area shape
@@ -14,7 +14,7 @@
 //!    on finger tips and noise; quantiles also make the graph independent of any monotone
 //!    rescaling of `f` (raw or log HKS give the same graph). By default each shape is cut at
 //!    its own quantiles: that is exactly the paper's own order of work, rank alignment of B
-//!    onto A (paper step 1, [`shapecorr::segmentation::rank_align`]) followed by joint
+//!    onto A (paper step 1, [`shapecorr::regions::segmentation::rank_align`]) followed by joint
 //!    clustering, since joint quantiles of rank-aligned values are each shape's own
 //!    quantiles. Joint quantiles of the raw values ([`ReebParams::joint_levels`]) measured
 //!    worse on FAUST (9 pairs, 8 levels: symmetric accuracy 0.696 vs 0.822) and on TOSCA
@@ -28,21 +28,21 @@
 //!    boundary grazes a saddle or a bump, most of them a handful of vertices) are merged,
 //!    smallest first, into the neighbour they share most edges with; when that makes two
 //!    components of the absorbing level touch, they become one node (it is now one
-//!    connected set of that level), as [`shapecorr::segmentation`] does with k-means fragments.
+//!    connected set of that level), as [`shapecorr::regions::segmentation`] does with k-means fragments.
 
 use std::time::Instant;
 
 use shapecorr::correspondence::{one_to_one_matches, Correspondence, Params, Timings};
-use shapecorr::descriptors::{hks, HksParams};
-use shapecorr::eigen::Eigenbasis;
-use shapecorr::graph::ShapeGraph;
-use shapecorr::matching::match_graphs;
-use shapecorr::segmentation::{compare_graphs, Regions};
+use shapecorr::regions::graph::ShapeGraph;
+use shapecorr::regions::matching::match_graphs;
+use shapecorr::regions::segmentation::{compare_graphs, Regions};
 use shapecorr::shape::Shape;
+use shapecorr::spectral::descriptors::{hks, HksParams};
+use shapecorr::spectral::eigen::Eigenbasis;
 use shapecorr::{Error, Result};
 
 /// HKS time of the baseline on the unit-area shape (the crate's HKS convention: absolute
-/// times after scaling the shape to unit area, [`shapecorr::descriptors`]).
+/// times after scaling the shape to unit area, [`shapecorr::spectral::descriptors`]).
 pub const DEFAULT_HKS_TIME: f64 = 0.1;
 
 /// Default number of level intervals, chosen to give the segment count of the paper's
@@ -54,7 +54,7 @@ pub const DEFAULT_HKS_TIME: f64 = 0.1;
 pub const DEFAULT_LEVELS: usize = 8;
 
 /// Default smallest component, as a fraction of the area (the value of
-/// [`shapecorr::segmentation::DEFAULT_MIN_REGION_AREA`]: about 14 vertices of a 6,890-vertex
+/// [`shapecorr::regions::segmentation::DEFAULT_MIN_REGION_AREA`]: about 14 vertices of a 6,890-vertex
 /// body). Clean meshes have no such specks (the ten FAUST shapes above: the same node
 /// counts with 0, 0.002 and 0.005 at 5-10 levels but one shape at 6 levels with 0.005);
 /// noisy point clouds have many (`tests/reeb.rs`, `merging_tames_a_noisy_point_cloud`).

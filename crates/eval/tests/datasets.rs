@@ -64,7 +64,7 @@ fn shared_order_layouts_faust_scape_and_tosca() {
         for (name, mesh) in names.iter().zip(&meshes) {
             let path = root.join(dataset).join(format!("{name}.ply"));
             std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-            shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
+            shapecorr::shape::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
         }
         write(
             &root.join("pairs").join(format!("{dataset}.txt")),
@@ -254,7 +254,7 @@ fn eigenbasis_cache_returns_the_same_basis_and_survives_damage() {
     let root = temp("cache");
     let mesh = &poses()[0];
     let path = root.join("shape.ply");
-    shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
+    shapecorr::shape::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
     let shape = Shape::read(&path, false).unwrap();
     let params = EigenParams {
         n_eigenpairs: 20,
@@ -311,7 +311,7 @@ fn pointwise_bench_keeps_its_eigenbases_in_the_cache() {
     for (name, mesh) in ["tr_reg_000", "tr_reg_001"].iter().zip(&poses()) {
         let path = root.join("faust").join(format!("{name}.ply"));
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
+        shapecorr::shape::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
     }
     let pairs = root.join("pairs/faust.txt");
     write(
@@ -324,7 +324,7 @@ fn pointwise_bench_keeps_its_eigenbases_in_the_cache() {
             &root,
             &pairs,
             &shapecorr::correspondence::Params::default(),
-            &shapecorr::pointwise::PointwiseParams::default(),
+            &shapecorr::maps::pointwise::PointwiseParams::default(),
             0,
             Some(&["regions".to_string()]),
             None,
@@ -364,7 +364,7 @@ fn shape_store_loads_once_and_cuts_nothing() {
     for (name, mesh) in ["tr_reg_000", "tr_reg_001"].iter().zip(&meshes) {
         let path = root.join("faust").join(format!("{name}.ply"));
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        shapecorr::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
+        shapecorr::shape::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
     }
     let d = Dataset::open(&root, "faust").unwrap();
     let params = EigenParams {

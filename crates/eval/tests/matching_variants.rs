@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use shapecorr::matching::{
+use shapecorr::regions::matching::{
     distance_histograms, leading_eigenvector, unary_costs, Affinity, DistanceTerm, MatchingParams,
 };
 
@@ -16,10 +16,11 @@ use shapecorr::matching::{
 fn measure_variants_on_benchmark_pairs() {
     use shapecorr::evaluation::score as region_scores;
     use shapecorr::geodesic::region_distance_matrix;
-    use shapecorr::matching::match_hop_distances;
-    use shapecorr::segmentation::{segment_pair, SegmentationParams};
-    use shapecorr::symmetry::{one_to_one, SymmetryParams};
-    use shapecorr::{hks, EigenParams, Eigenbasis, HksParams, Shape};
+    use shapecorr::regions::matching::match_hop_distances;
+    use shapecorr::regions::segmentation::{segment_pair, SegmentationParams};
+    use shapecorr::regions::symmetry::{one_to_one, SymmetryParams};
+    use shapecorr::spectral::descriptors::{hks, HksParams};
+    use shapecorr::{EigenParams, Eigenbasis, Shape};
     use shapecorr_eval::datasets::{default_data_root, read_pairs, Dataset};
     use std::collections::HashMap;
 

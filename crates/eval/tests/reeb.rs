@@ -4,7 +4,7 @@
 
 use shapecorr::correspondence::Params;
 use shapecorr::evaluation::score_correspondence;
-use shapecorr::graph::ShapeGraph;
+use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec};
 use shapecorr::{EigenParams, Eigenbasis, Error, Shape};
 use shapecorr_eval::reeb::{

@@ -1,4 +1,4 @@
-//! Symmetry breaking (paper, section 5.2; DESIGN step 12 and section 4): from the symmetric
+//! Symmetry breaking (paper, section 5.2; docs/design.md, step 12; docs/decisions.md, "One-to-one method"): from the symmetric
 //! (many-to-many) region matches to a one-to-one region correspondence.
 //!
 //! The symmetric matches fall into groups, the connected components of their bipartite
@@ -7,16 +7,16 @@
 //! maximum-cardinality matchings inside the symmetric matches, and the choices must agree
 //! with each other (flip all limbs or none). Two methods:
 //!
-//! - [`OneToOneMethod::WholeAssignment`] (default; DESIGN section 4, the measured best):
+//! - [`OneToOneMethod::WholeAssignment`] (default; docs/decisions.md, "One-to-one method", the measured best):
 //!   choose all groups' options together to minimise the unweighted distortion of the
 //!   region distances, `E(P) = (1/|P|^2) * sum_{(i,j),(k,l) in P} c(D1[i,k] - D2[j,l])`
 //!   with the cost `c` of [`DistortionCost`]: squared by default (measured better than
-//!   DESIGN's absolute value, see there); [`distortion_energy`] is the absolute form.
+//!   the absolute value, docs/decisions.md, "Distortion cost"); [`distortion_energy`] is the absolute form.
 //!   Exhaustively when the product of the option counts is at most
 //!   [`SymmetryParams::exhaustive_limit`]; otherwise by group-wise sweeps from a greedy
 //!   start and seeded random starts.
 //! - [`OneToOneMethod::Greedy`]: the paper's greedy growth, [`greedy_one_to_one`], kept for
-//!   comparison (it flips some limbs and not others more often, DESIGN section 4).
+//!   comparison (it flips some limbs and not others more often, docs/decisions.md, "One-to-one method").
 //!
 //! A global left/right flip of the answer is not an error (paper, section 5.2).
 
@@ -26,14 +26,14 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::{Error, Result};
 
-/// Default [`SymmetryParams::exhaustive_limit`]: DESIGN section 4 minimised exhaustively up
+/// Default [`SymmetryParams::exhaustive_limit`]: the first study (docs/decisions.md, "One-to-one search") minimised exhaustively up
 /// to about 5000 combinations (a few milliseconds here).
 pub const DEFAULT_EXHAUSTIVE_LIMIT: usize = 5000;
 /// Default [`SymmetryParams::restarts`]: random starts of the local search besides the
-/// greedy start ("several seeded random choices", DESIGN section 4).
+/// greedy start ("several seeded random choices", docs/decisions.md, "One-to-one search").
 pub const DEFAULT_RESTARTS: usize = 8;
 /// Groups with more options than this are re-chosen in the sweeps by an assignment on
-/// summed costs instead of trying every option (DESIGN section 4: "more than ~120
+/// summed costs instead of trying every option (docs/decisions.md, "One-to-one search": "more than ~120
 /// options"; 120 = 5!, a 5x5 group).
 pub const LARGE_GROUP_OPTIONS: usize = 120;
 /// Most options enumerated for one group (8!, a complete 8x8 group, the paper's maximum
@@ -48,7 +48,7 @@ const IMPROVEMENT_TOLERANCE: f64 = 1e-12;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum OneToOneMethod {
     /// Minimise the distortion of region distances over all groups' choices together
-    /// (DESIGN section 4: one-to-one accuracy 0.954 against 0.892 for the greedy growth).
+    /// (docs/decisions.md, "One-to-one method": one-to-one accuracy 0.954 against 0.892 for the greedy growth).
     WholeAssignment,
     /// The paper's greedy growth from the smallest ambiguous group ([`greedy_one_to_one`]).
     Greedy,
@@ -82,7 +82,7 @@ pub struct SymmetryParams {
 /// terms outweigh the many small differences between neighbouring regions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DistortionCost {
-    /// `|D1[i,k] - D2[j,l]|` (DESIGN section 4).
+    /// `|D1[i,k] - D2[j,l]|` (docs/decisions.md, "Distortion cost").
     Absolute,
     /// `(D1[i,k] - D2[j,l])^2`.
     Squared,
@@ -106,10 +106,10 @@ impl Default for SymmetryParams {
 pub fn bipartite_groups(matches: &[(u32, u32)]) -> Vec<(Vec<u32>, Vec<u32>)> {
     let n_a = matches.iter().map(|m| m.0 as usize + 1).max().unwrap_or(0);
     let n_b = matches.iter().map(|m| m.1 as usize + 1).max().unwrap_or(0);
-    crate::matching::symmetry_groups(matches, n_a, n_b)
+    crate::regions::matching::symmetry_groups(matches, n_a, n_b)
 }
 
-/// The unweighted distortion of a one-to-one correspondence `pairs` (DESIGN section 4):
+/// The unweighted distortion of a one-to-one correspondence `pairs` (docs/design.md, step 12):
 /// `E(P) = (1/|P|^2) * sum_{(i,j),(k,l) in P} |D1[i,k] - D2[j,l]|` over ordered pairs;
 /// 0 for no pairs.
 ///

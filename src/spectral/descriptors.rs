@@ -1,11 +1,11 @@
 //! Spectral point descriptors from an [`Eigenbasis`] of the unit-area shape
-//! (DESIGN.md step 5): the heat kernel signature (Sun, Ovsjanikov and Guibas 2009) and the
+//! (docs/design.md, step 5): the heat kernel signature (Sun, Ovsjanikov and Guibas 2009) and the
 //! wave kernel signature (Aubry, Schlickewei and Cremers 2011). Both are matrices with one
 //! row per input vertex and one column per time (HKS) or energy (WKS).
 
 use faer::Mat;
 
-use crate::eigen::Eigenbasis;
+use crate::spectral::eigen::Eigenbasis;
 use crate::{Error, Result};
 
 /// Parameters of the heat kernel signature.
@@ -18,7 +18,7 @@ pub struct HksParams {
     /// Largest time on the unit-area shape (paper: 0.25).
     pub t_max: f64,
     /// Take the logarithm of the signature (the authors' code does; raw HKS measured better
-    /// in the paper's pipeline, DESIGN.md section 4).
+    /// in the paper's pipeline, docs/decisions.md, "HKS: raw, not log").
     pub log: bool,
 }
 

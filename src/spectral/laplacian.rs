@@ -1,5 +1,5 @@
 //! The Laplace-Beltrami operator as a stiffness matrix `L` and a lumped mass `M`, on the
-//! unit-area shape (DESIGN.md step 3).
+//! unit-area shape (docs/design.md, step 3).
 //!
 //! * Meshes: cotangent stiffness with barycentric lumped mass, computed from edge lengths
 //!   after *intrinsic mollification* (Sharp and Crane 2020, "A Laplacian for Nonmanifold
@@ -21,7 +21,7 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use sprs::{CsMat, TriMat};
 
-use crate::neighbors::PointTree;
+use crate::shape::neighbors::PointTree;
 use crate::shape::{distance, Shape, ShapeKind};
 use crate::{Error, Result};
 

@@ -7,14 +7,17 @@
 //! ignored and reported as [`Warning`]s. The caller's vertex order is kept exactly: every
 //! per-vertex output of the library is indexed by the input vertices.
 
+pub mod io;
+pub mod neighbors;
+
 use std::collections::HashMap;
 
-use crate::io::RawShape;
-use crate::neighbors::{symmetric_knn_graph, PointTree};
+use crate::shape::io::RawShape;
+use crate::shape::neighbors::{symmetric_knn_graph, PointTree};
 use crate::{Error, Result};
 
 /// Fewest usable vertices the pipeline accepts. The point-cloud Laplacian looks at
-/// [`crate::laplacian::POINT_CLOUD_NEIGHBORS`] neighbours of every point and the
+/// [`crate::spectral::laplacian::POINT_CLOUD_NEIGHBORS`] neighbours of every point and the
 /// descriptors need a spectrum of some length, so anything smaller is rejected.
 pub const MIN_VERTICES: usize = 32;
 
@@ -139,7 +142,7 @@ impl Shape {
 
     /// Reads a file (OFF, OBJ, PLY, XYZ/PTS) into a shape.
     pub fn read(path: &std::path::Path, as_point_cloud: bool) -> Result<Shape> {
-        Shape::from_raw(crate::io::read_shape(path)?, as_point_cloud)
+        Shape::from_raw(crate::shape::io::read_shape(path)?, as_point_cloud)
     }
 
     fn build(vertices: Vec<[f64; 3]>, polygons: &[&[u32]], kind: ShapeKind) -> Result<Shape> {
@@ -277,7 +280,7 @@ impl Shape {
     }
 
     /// Total surface area of a mesh in the input units (0 for a point cloud: its area is
-    /// estimated by the Laplacian's mass, [`crate::laplacian::Laplacian::input_area`]).
+    /// estimated by the Laplacian's mass, [`crate::spectral::laplacian::Laplacian::input_area`]).
     pub fn mesh_area(&self) -> f64 {
         self.triangles
             .iter()

@@ -1,4 +1,4 @@
-//! Joint segmentation of two shapes and their shape graphs (paper, section 4; DESIGN.md
+//! Joint segmentation of two shapes and their shape graphs (paper, section 4; docs/design.md,
 //! steps 6-9).
 //!
 //! 1. [`rank_align`]: every descriptor column of shape B is mapped onto the values of shape A
@@ -24,7 +24,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::graph::{ShapeGraph, UNREACHABLE};
+use crate::regions::graph::{ShapeGraph, UNREACHABLE};
 use crate::shape::{DisjointSets, Shape};
 use crate::{Error, Result};
 
@@ -69,7 +69,7 @@ pub const DEFAULT_METRIC: KMeansMetric = KMeansMetric::Euclidean;
 /// How ties between k values with the same degree-histogram difference are broken.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum KTieBreak {
-    /// The smallest k wins (DESIGN.md section 4: accuracy falls as k grows; k = 5 was then
+    /// The smallest k wins (docs/decisions.md, "k tie-break": accuracy falls as k grows; k = 5 was then
     /// chosen in 90 of 94 pairs).
     #[default]
     SmallestK,
@@ -82,7 +82,7 @@ pub enum KTieBreak {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum RegionExpansion {
     /// `R` plus the vertices of other clusters whose second nearest centroid is `c` (the
-    /// authors' release; DESIGN.md section 4). Graphs follow the shape's structure: on a
+    /// authors' release; docs/decisions.md, "Region expansion"). Graphs follow the shape's structure: on a
     /// star, body - limb middle - limb tip; on FAUST bodies, trees (16-25 nodes, one edge
     /// fewer).
     #[default]
@@ -188,7 +188,7 @@ pub struct SegmentationParams {
 impl Default for SegmentationParams {
     /// k = 5..=10 (paper), 3 restarts (authors), Euclidean k-means ([`DEFAULT_METRIC`]),
     /// at most 60 regions (authors), fragments below [`DEFAULT_MIN_REGION_AREA`] merged,
-    /// the authors' second-nearest band, ties towards the smaller k (DESIGN.md section 4).
+    /// the authors' second-nearest band, ties towards the smaller k (docs/decisions.md, "Segmentation").
     fn default() -> Self {
         SegmentationParams {
             k_min: 5,
@@ -1183,7 +1183,7 @@ fn update(
 // Step 3: shape graph
 // ---------------------------------------------------------------------------------------
 
-/// The shape graph of one shape (paper, section 4, step 3; DESIGN.md step 8) with the
+/// The shape graph of one shape (paper, section 4, step 3; docs/design.md, step 8) with the
 /// default [`GraphParams`]. See [`shape_graph_with`].
 pub fn shape_graph(
     shape: &Shape,
@@ -1672,7 +1672,7 @@ pub fn rank_align_common(
     (average(a, &a_on_b), average(b, &b_on_a))
 }
 
-/// Joint segmentation of two shapes (paper, section 4; DESIGN.md steps 6-9).
+/// Joint segmentation of two shapes (paper, section 4; docs/design.md, steps 6-9).
 ///
 /// Both shapes' descriptors are rank-aligned to a common distribution
 /// ([`rank_align_common`]); for every k in

@@ -1,6 +1,6 @@
 //! The shape graph (paper, section 4): a node for every connected region of every joint
 //! cluster, edges between regions whose expanded regions overlap. Built by
-//! [`crate::segmentation`], matched by [`crate::matching`].
+//! [`crate::regions::segmentation`], matched by [`crate::regions::matching`].
 
 /// A shape's decomposition into regions and the graph over them.
 #[derive(Debug, Clone, PartialEq)]

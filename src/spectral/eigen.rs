@@ -1,5 +1,5 @@
 //! The smallest generalized eigenpairs `L phi = lambda M phi` of the unit-area shape
-//! (DESIGN.md step 4), computed once per shape and reused by every later stage.
+//! (docs/design.md, step 4), computed once per shape and reused by every later stage.
 //!
 //! Method: shift-invert. `A = L + sigma M` (sigma > 0, so A is positive definite even for
 //! several connected pieces) is factored once by faer's supernodal sparse Cholesky; the
@@ -18,10 +18,10 @@ use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::laplacian::Laplacian;
 use crate::progress::{check, NoProgress, Progress, Stage};
 use crate::shape::Shape;
-use crate::sparse::SparseCholesky;
+use crate::spectral::laplacian::Laplacian;
+use crate::spectral::sparse::SparseCholesky;
 use crate::{Error, Result};
 
 /// Parameters of the eigensolver. The defaults are the documented ones.

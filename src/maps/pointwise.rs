@@ -1,7 +1,7 @@
-//! Point-to-point maps from region correspondences (DESIGN.md step 13, paper section 6.4):
+//! Point-to-point maps from region correspondences (docs/design.md, step 13, paper section 6.4):
 //! the matched regions' indicator functions (optionally heat-diffused, optionally with WKS
 //! or HKS) constrain a functional map, which is converted to a vertex map and refined by
-//! ZoomOut (beyond the paper). See [`crate::fmap`] for the building blocks.
+//! ZoomOut (beyond the paper). See [`crate::maps::fmap`] for the building blocks.
 //!
 //! Direction: the output `p2p_ba[v]` is the vertex of A matched to vertex `v` of B
 //! (`map_b_to_a.txt`); `fmap_ab` maps functions on A to functions on B.
@@ -12,15 +12,15 @@ use faer::Mat;
 use rayon::prelude::*;
 
 use crate::correspondence::{Correspondence, Params};
-use crate::descriptors::{hks, wks, HksParams, WksParams};
-use crate::eigen::{EigenParams, Eigenbasis};
-use crate::fmap::{
+use crate::maps::fmap::{
     fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, project,
     solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, SampledZoomOut,
     ZoomOutParams,
 };
 use crate::progress::{check, Progress, Stage};
 use crate::shape::Shape;
+use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
+use crate::spectral::eigen::{EigenParams, Eigenbasis};
 use crate::{Error, Result};
 
 /// Which region matches constrain the functional map.
@@ -618,7 +618,7 @@ fn sample_triangles(
     samples_b: &[u32],
 ) -> Vec<([usize; 3], bool)> {
     let points: Vec<[f64; 3]> = samples_b.iter().map(|&v| vb[v as usize]).collect();
-    let tree = crate::neighbors::PointTree::new(&points);
+    let tree = crate::shape::neighbors::PointTree::new(&points);
     let mut triangles = Vec::with_capacity(points.len());
     for (s, p) in points.iter().enumerate() {
         let near: Vec<usize> = tree
@@ -730,7 +730,7 @@ const MIRROR_OPTIONS_CAP: usize = 5040;
 /// The mirror image of the one-to-one answer: in every symmetric group with a choice, a
 /// different matching of the same size (for a left/right pair: the swap), the groups chosen
 /// together to minimise the distortion of region distances
-/// ([`crate::symmetry::distortion_energy`]) by a few sweeps of coordinate descent. A region
+/// ([`crate::regions::symmetry::distortion_energy`]) by a few sweeps of coordinate descent. A region
 /// may keep its partner: a centaur's group of two arms and a middle region mirrors by
 /// swapping the arms only (requiring every pair to change, as this did before, left such
 /// groups no true mirror, and the centaurs' maps mirrored). Returned as one-to-one groups;
@@ -745,13 +745,13 @@ fn mirrored_groups(
     let current = &regions.matches_one_to_one;
     let mut fixed: Vec<(u32, u32)> = Vec::new();
     let mut choices: Vec<Vec<Vec<(u32, u32)>>> = Vec::new();
-    for (ra, rb) in crate::symmetry::bipartite_groups(&regions.matches) {
+    for (ra, rb) in crate::regions::symmetry::bipartite_groups(&regions.matches) {
         let in_group = |p: &(u32, u32)| ra.binary_search(&p.0).is_ok();
         let mut mine: Vec<(u32, u32)> = current.iter().copied().filter(in_group).collect();
         mine.sort_unstable();
         let edges: Vec<(u32, u32)> = regions.matches.iter().copied().filter(in_group).collect();
         let (options, complete) =
-            crate::symmetry::max_matchings(&ra, &rb, &edges, MIRROR_OPTIONS_CAP + 1);
+            crate::regions::symmetry::max_matchings(&ra, &rb, &edges, MIRROR_OPTIONS_CAP + 1);
         // Each option lists its pairs by ascending A region, as `mine` does.
         let full: Vec<Vec<(u32, u32)>> = options
             .into_iter()
@@ -788,7 +788,7 @@ fn mirrored_groups(
         pairs
     };
     let energy = |pick: &[usize]| {
-        crate::symmetry::distortion_energy(&assemble(pick), d_a.as_ref(), d_b.as_ref())
+        crate::regions::symmetry::distortion_energy(&assemble(pick), d_a.as_ref(), d_b.as_ref())
     };
     let mut pick = vec![0usize; choices.len()];
     for _sweep in 0..4 {
@@ -886,7 +886,7 @@ pub fn truncated(basis: &Eigenbasis, k: usize) -> Eigenbasis {
 
 /// The corresponding region sets that constrain the map: one pair per one-to-one match,
 /// or one per group of symmetric matches (the connected components of their bipartite
-/// graph, [`crate::symmetry::bipartite_groups`]).
+/// graph, [`crate::regions::symmetry::bipartite_groups`]).
 pub fn region_groups(
     regions: &Correspondence,
     kind: RegionConstraints,
@@ -898,7 +898,9 @@ pub fn region_groups(
             .iter()
             .map(|&(i, j)| (vec![i], vec![j]))
             .collect(),
-        RegionConstraints::Symmetric => crate::symmetry::bipartite_groups(&regions.matches),
+        RegionConstraints::Symmetric => {
+            crate::regions::symmetry::bipartite_groups(&regions.matches)
+        }
     }
 }
 
@@ -988,26 +990,4 @@ fn normalised_columns(blocks: &[Mat<f64>]) -> Mat<f64> {
             0.0
         }
     })
-}
-
-/// A smooth colour field for looking at maps: each vertex's coordinates normalised to the
-/// bounding box, as RGB.
-pub fn coordinate_colors(vertices: &[[f64; 3]]) -> Vec<[u8; 3]> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in vertices {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    vertices
-        .iter()
-        .map(|p| {
-            std::array::from_fn(|k| {
-                let span = (hi[k] - lo[k]).max(f64::MIN_POSITIVE);
-                (((p[k] - lo[k]) / span).clamp(0.0, 1.0) * 255.0).round() as u8
-            })
-        })
-        .collect()
 }

@@ -1,6 +1,6 @@
 //! Functional maps (Ovsjanikov et al. 2012) between two eigenbases, and the conversions
 //! between functional and pointwise maps, with ZoomOut (Melzi et al. 2019) and spectral ICP
-//! refinement (DESIGN.md step 13; paper section 6.4).
+//! refinement (docs/design.md, step 13; paper section 6.4).
 //!
 //! Conventions (pyFM's): shape 1 is A, shape 2 is B. `fmap_12` is a `k2 x k1` matrix that
 //! maps the spectral coefficients of a function on shape 1 to those of the transported

@@ -1,5 +1,5 @@
 //! Graph matching (paper, section 5.1 "Subspace-based Spectral Matching", and the
-//! discretisation after it; DESIGN steps 10-11): a symmetric, many-to-many correspondence
+//! discretisation after it; docs/design.md, steps 10-11): a symmetric, many-to-many correspondence
 //! between the nodes of two [`ShapeGraph`]s from their connectivity alone.
 //!
 //! Candidates are all node pairs `(i, j)`, `i` on A and `j` on B, indexed row-major
@@ -31,7 +31,7 @@ use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigen
 use faer::{Mat, Par};
 use rayon::prelude::*;
 
-use crate::graph::{ShapeGraph, UNREACHABLE};
+use crate::regions::graph::{ShapeGraph, UNREACHABLE};
 use crate::{Error, Result};
 
 /// The graph-distance term `d_g` of the pairwise affinity, between the hop distance
@@ -56,7 +56,7 @@ impl DistanceTerm {
     }
 }
 
-/// Parameters of the graph matching (paper, section 5.1; DESIGN steps 10-11).
+/// Parameters of the graph matching (paper, section 5.1; docs/design.md, steps 10-11).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MatchingParams {
     /// Bandwidth of every affinity `exp(-d / sigma)`. Paper: 0.5. (The authors' code
@@ -145,7 +145,7 @@ pub struct GraphMatching {
     pub scores: Vec<f64>,
 }
 
-/// Matches the nodes of two shape graphs (paper, section 5.1; DESIGN steps 10-11).
+/// Matches the nodes of two shape graphs (paper, section 5.1; docs/design.md, steps 10-11).
 ///
 /// Errors: invalid parameters, a graph without nodes, or edges naming missing nodes.
 pub fn match_graphs(
@@ -734,7 +734,7 @@ fn small_eigen(h: &[f64], m: usize, stride: usize) -> Result<(Vec<f64>, Mat<f64>
     Ok((values, u))
 }
 
-/// Discretisation (paper, end of section 5.1; DESIGN step 11). For every node of A, its
+/// Discretisation (paper, end of section 5.1; docs/design.md, step 11). For every node of A, its
 /// scores over B sorted high to low (ties by index) are cut before the first value below
 /// `gap_ratio` times the previous one (the end of the row counts as a cut; a zero score
 /// always cuts); the node keeps the candidates before the cut if they are at most

@@ -1,0 +1,5 @@
+//! Point-to-point maps from the region correspondence (paper, section 6.4): functional
+//! maps and their refinement ([`fmap`]), and the whole pointwise job ([`pointwise`]).
+
+pub mod fmap;
+pub mod pointwise;
