@@ -3,7 +3,8 @@
 
     python blender_addon/build.py            # -> target/blender/shapecorr-<version>-linux_x64.zip
 
-Options: --lib PATH packages an already built library instead of running cargo;
+Without --lib it builds the library with the shipping profile (`cargo build --profile dist`:
+no debug information). Options: --lib PATH packages an already built library as it is;
 --out DIR changes the output folder. To build for another platform, run this on that
 platform (the library must be compiled there): it names the zip and the manifest's
 `platforms` after it (windows-x64, macos-arm64, macos-x64, linux-arm64).
@@ -12,10 +13,8 @@ platform (the library must be compiled there): it names the zip and the manifest
 import argparse
 import platform
 import re
-import shutil
 import subprocess
 import sys
-import tempfile
 import zipfile
 from pathlib import Path
 
@@ -37,8 +36,10 @@ def build(library=None, out=None):
     """Builds the zip and returns its path."""
     name = LIBRARY_NAMES[sys.platform]
     if library is None:
-        subprocess.run(["cargo", "build", "--release", "--locked", "--lib"], cwd=REPOSITORY, check=True)
-        library = REPOSITORY / "target" / "release" / name
+        # The shipping profile: the release build without debug information.
+        command = ["cargo", "build", "--profile", "dist", "--locked", "-p", "shapecorr", "--lib"]
+        subprocess.run(command, cwd=REPOSITORY, check=True)
+        library = REPOSITORY / "target" / "dist" / name
     library = Path(library)
     if not library.is_file():
         raise SystemExit(f"no library at {library}")
@@ -55,21 +56,8 @@ def build(library=None, out=None):
             archive.write(path, path.name)
         for path in sorted(BINDING.glob("*.py")):
             archive.write(path, f"shapecorr/{path.name}")
-        with tempfile.TemporaryDirectory() as folder:
-            archive.write(stripped(library, Path(folder)), f"shapecorr/{name}")
+        archive.write(library, f"shapecorr/{name}")
     return zip_path
-
-
-def stripped(library, folder):
-    """A copy of the library without debug sections (29 MB -> about 6 MB; the zip is 1.6 MB) when `strip` is
-    available, else the library itself."""
-    strip = shutil.which("strip")
-    if strip is None or sys.platform == "win32":
-        return library
-    copy = folder / library.name
-    shutil.copyfile(library, copy)
-    subprocess.run([strip, "--strip-debug", str(copy)], check=True)
-    return copy
 
 
 def main():

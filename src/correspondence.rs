@@ -47,6 +47,9 @@ pub struct Params {
     /// 0.801 -> 0.923); two pairs change. A smaller t_min for every pair instead hurt remeshed
     /// TOSCA (0.940, one pair 0.013). `None` turns it off.
     pub fallback: Option<HksFallback>,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 /// Eigenpairs for region matching. The HKS at t >= 0.03 only needs the eigenvalues with
@@ -67,6 +70,7 @@ impl Default for Params {
             symmetry: SymmetryParams::default(),
             skip_one_to_one: false,
             fallback: Some(HksFallback::default()),
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -104,12 +108,19 @@ impl Params {
 #[derive(Debug, Clone, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Timings {
+    /// Eigenbasis of shape A (0 when the bases were given, [`Correspondence::from_bases`]).
     pub eigenbasis_a: f64,
+    /// Eigenbasis of shape B (0 when the bases were given, [`Correspondence::from_bases`]).
     pub eigenbasis_b: f64,
+    /// HKS descriptors of both shapes, the fallback try included.
     pub descriptors: f64,
+    /// Joint segmentation and shape graphs, the fallback try included.
     pub segmentation: f64,
+    /// Spectral graph matching, the fallback try included.
     pub matching: f64,
+    /// Symmetry breaking into the one-to-one matches.
     pub one_to_one: f64,
+    /// Whole call, from [`Correspondence::compute`] or [`Correspondence::from_bases`].
     pub total: f64,
 }
 

@@ -5,41 +5,83 @@ use std::path::PathBuf;
 
 /// Everything that can go wrong in shapecorr, with what was received and how to fix it.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A vertex coordinate is NaN or infinite.
     #[error("vertex {vertex} has a non-finite coordinate {value} (NaN or infinity); remove or repair it")]
-    NonFiniteCoordinate { vertex: usize, value: f64 },
+    NonFiniteCoordinate {
+        /// Index of the offending input vertex (0-based).
+        vertex: usize,
+        /// The first non-finite coordinate of that vertex.
+        value: f64,
+    },
     /// A face refers to a vertex that does not exist.
     #[error("face {face} refers to vertex {index}, but the shape has only {n_vertices} vertices (indices are 0-based)")]
     FaceIndexOutOfRange {
+        /// Index of the offending face in the input face list (0-based).
         face: usize,
+        /// The out-of-range vertex index the face refers to (0-based).
         index: u64,
+        /// Number of vertices the shape has.
         n_vertices: usize,
     },
     /// A face with fewer than three corners.
     #[error("face {face} has {corners} corners; a face needs at least 3")]
-    FaceTooSmall { face: usize, corners: usize },
+    FaceTooSmall {
+        /// Index of the offending face in the input face list (0-based).
+        face: usize,
+        /// Number of corners the face has (fewer than 3).
+        corners: usize,
+    },
     /// Not enough (referenced) vertices for the pipeline.
     #[error("the shape has {received} usable vertices; at least {required} are needed")]
-    TooFewVertices { received: usize, required: usize },
+    TooFewVertices {
+        /// Usable vertices received: all input vertices, or those used by a face for a mesh.
+        received: usize,
+        /// Fewest usable vertices accepted ([`crate::shape::MIN_VERTICES`]).
+        required: usize,
+    },
     /// The surface has no area (all faces degenerate, or all points coincide).
     #[error("the shape has zero total area ({detail}); it cannot be normalised")]
-    ZeroArea { detail: String },
+    ZeroArea {
+        /// Why the area is zero (no faces, all faces degenerate, or all points coincide).
+        detail: String,
+    },
     /// A parameter is out of its valid range.
     #[error("invalid parameter `{name}`: {reason}")]
-    InvalidParameter { name: &'static str, reason: String },
+    InvalidParameter {
+        /// Name of the parameter or argument, e.g. `segmentation.k_max` or `colors`.
+        name: &'static str,
+        /// What is wrong with the value.
+        reason: String,
+    },
     /// A file could not be read or parsed.
     #[error("{path}: {reason}")]
-    File { path: PathBuf, reason: String },
+    File {
+        /// The file (for in-memory parsing, the name the caller gave it).
+        path: PathBuf,
+        /// What went wrong reading, parsing or writing it.
+        reason: String,
+    },
     /// A numerical method failed (factorisation or eigensolver), with the detail.
     #[error("numerical failure in {stage}: {reason}")]
-    Numerical { stage: &'static str, reason: String },
+    Numerical {
+        /// The pipeline stage that failed, e.g. `eigensolver` or `functional map`.
+        stage: &'static str,
+        /// The detail reported by the failing method.
+        reason: String,
+    },
     /// The caller asked to stop through the progress callback.
     #[error("cancelled by the caller")]
     Cancelled,
     /// An option name that does not exist (see [`crate::options::OPTIONS`]).
     #[error("unknown option `{name}`; the options are: {known}")]
-    UnknownOption { name: String, known: String },
+    UnknownOption {
+        /// The option name that was asked for.
+        name: String,
+        /// Comma-separated list of the option names that exist.
+        known: String,
+    },
 }
 
 /// Result with the crate's [`Error`].

@@ -24,8 +24,9 @@ pub struct RegionScores {
     pub coverage: f64,
     /// Area fraction of A in regions without any symmetric match.
     pub unmatched: f64,
-    /// Number of regions of A and B.
+    /// Number of regions of A.
     pub n_regions_a: usize,
+    /// Number of regions of B.
     pub n_regions_b: usize,
 }
 
@@ -197,12 +198,14 @@ pub fn pointwise_errors(
 pub struct ErrorSummary {
     /// Mean normalised geodesic error.
     pub mean: f64,
-    /// Fraction of pairs with error at most 0.05 and at most 0.10.
+    /// Fraction of pairs with error at most 0.05.
     pub within_005: f64,
+    /// Fraction of pairs with error at most 0.10.
     pub within_010: f64,
 }
 
 impl ErrorSummary {
+    /// Summary of one map's normalised geodesic errors (all zeros for none).
     pub fn of(errors: &[f64]) -> ErrorSummary {
         let n = errors.len().max(1) as f64;
         let within = |t: f64| errors.iter().filter(|&&e| e <= t).count() as f64 / n;

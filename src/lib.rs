@@ -43,6 +43,7 @@
 // `!(x > 0.0)` is the NaN-rejecting comparison this numerical code means; clippy's rewrite
 // with `partial_cmp` would hide that.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![warn(missing_docs)]
 
 pub mod colors;
 pub mod correspondence;
@@ -64,3 +65,9 @@ pub use maps::pointwise::{PointwiseCorrespondence, PointwiseParams};
 pub use progress::{NoProgress, Progress, Stage};
 pub use shape::{Shape, ShapeKind, Warning};
 pub use spectral::eigen::{EigenParams, Eigenbasis};
+
+/// The hidden last field of every params struct (faer's pattern): callers outside the crate
+/// cannot name every field, so they write `Params { k_max: 8, ..Default::default() }` and a
+/// new parameter never breaks them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NonExhaustive(pub(crate) ());

@@ -139,6 +139,7 @@ fn zoomout_repairs_a_perturbed_identity_map() {
         k_end: 60,
         step: 2,
         sample_size: 0,
+        ..Default::default()
     };
     let (c, refined) =
         zoomout(start.as_ref(), phi, &basis.mass, phi, &basis.mass, &params).unwrap();

@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Runs every test of the project: the Rust unit, integration and documentation tests
+# Runs every test of the project: the layout limits (tests/layout/check.py: modules at most
+# 1,200 lines, functions at most 150), the Rust unit, integration and documentation tests of
+# the workspace (the pipeline crate, crates/eval, crates/cli)
 # (library, file readers, generated figures, spectral identities, region correspondence,
 # command line, the C header's drift check), the C API's tests (plain, AddressSanitizer +
 # UndefinedBehaviorSanitizer, valgrind; C++ wrapper; example programs) and the Python
@@ -11,9 +13,10 @@
 # without it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+python3 tests/layout/check.py
 cargo build --release --locked
-cargo test --release --locked --all-targets
-cargo test --release --locked --doc
+cargo test --release --locked --workspace --all-targets
+cargo test --release --locked --workspace --doc
 bash tests/c/run.sh
 bash tests/python/run.sh
 bash tests/blender/run.sh

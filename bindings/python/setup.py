@@ -1,7 +1,9 @@
 """Builds the package with the compiled library inside it.
 
-`pip install ./bindings/python` runs `cargo build --release --locked --lib` in the
-repository (two levels up) and copies target/release/libshapecorr.so into the package.
+`pip install ./bindings/python` runs `cargo build --profile dist --locked -p shapecorr --lib`
+in the repository (two levels up): the release build without debug information, the
+library as shipped (about 6 MB instead of 33 MB), and copies target/dist/libshapecorr.so
+into the package.
 Set SHAPECORR_LIB to a library file to package that one instead (no cargo needed).
 """
 
@@ -33,9 +35,11 @@ def compiled_library():
             "SHAPECORR_LIB to a compiled library"
         )
     subprocess.run(
-        ["cargo", "build", "--release", "--locked", "--lib"], cwd=REPOSITORY, check=True
+        ["cargo", "build", "--profile", "dist", "--locked", "-p", "shapecorr", "--lib"],
+        cwd=REPOSITORY,
+        check=True,
     )
-    return REPOSITORY / "target" / "release" / LIBRARY_NAME
+    return REPOSITORY / "target" / "dist" / LIBRARY_NAME
 
 
 class BuildWithLibrary(build_py):

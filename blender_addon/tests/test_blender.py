@@ -24,7 +24,7 @@ def addon(tmp_path_factory):
         sys.path.insert(0, str(REPOSITORY / "blender_addon"))
         import build
 
-        zip_path = build.build(REPOSITORY / "target" / "release" / "libshapecorr.so",
+        zip_path = build.build(REPOSITORY / "target" / "dist" / "libshapecorr.so",
                                tmp_path_factory.mktemp("zip"))
     sys.path.insert(0, str(REPOSITORY / "tests" / "blender"))
     import render_scene
@@ -206,9 +206,26 @@ def test_settings_default_to_the_library_defaults(addon):
     fresh_scene()
     settings = bpy.context.scene.shapecorr
     defaults = {name: value for name, _, _, value in addon.shapecorr.options()}
-    assert settings.k_min == defaults["k_min"]
-    assert settings.k_max == defaults["k_max"]
-    assert settings.one_to_one == defaults["one_to_one"]
+    passed = settings.library_options()
+    # Every option the panel passes is a name of the library's one table, with its default.
+    assert passed and set(passed) <= set(defaults), set(passed) - set(defaults)
+    for name, value in passed.items():
+        assert value == defaults[name], name
+        assert getattr(settings, name) == defaults[name], name
+
+
+def test_the_extension_ships_a_small_library():
+    zip_path = os.environ.get("SHAPECORR_BLENDER_ZIP")
+    if zip_path is None:
+        pytest.skip("needs the zip built by tests/blender/run.sh")
+    import zipfile
+
+    with zipfile.ZipFile(zip_path) as archive:
+        sizes = {i.filename: i.file_size for i in archive.infolist()}
+    library = [name for name in sizes if name.startswith("shapecorr/libshapecorr")]
+    assert library, sorted(sizes)
+    # Built with the `dist` profile, no debug information (issue 17: at most 8 MB).
+    assert sizes[library[0]] <= 8 * 1024 * 1024, sizes[library[0]]
 
 
 def test_render_the_coloured_figures_with_cycles(addon, tmp_path):

@@ -198,8 +198,11 @@ pub fn orientation_operators(
 /// et al. 2018).
 #[derive(Debug, Clone, Copy)]
 pub struct Commutativity<'a> {
+    /// Operators `D1_f` on shape 1 (each `k1 x k1`).
     pub operators_a: &'a [Mat<f64>],
+    /// Operators `D2_f` on shape 2 (each `k2 x k2`), one per operator in `operators_a`.
     pub operators_b: &'a [Mat<f64>],
+    /// Weight `w` of the term (finite, >= 0; 0 drops it).
     pub weight: f64,
 }
 
@@ -609,7 +612,9 @@ pub fn p2p_to_fmap(
 /// vertex indices and the weights that stand for the area around each.
 #[derive(Debug, Clone)]
 pub struct Sample {
+    /// Sampled vertex indices (0-based rows of the eigenbasis), ascending.
     pub vertices: Vec<u32>,
+    /// Weight of each vertex of `vertices`, in the same order: its mass.
     pub weights: Vec<f64>,
 }
 
@@ -676,6 +681,9 @@ pub struct ZoomOutParams {
     /// Vertices per shape on which the iterations run (0 = every vertex); the final map is
     /// always computed on every vertex.
     pub sample_size: usize,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for ZoomOutParams {
@@ -684,6 +692,7 @@ impl Default for ZoomOutParams {
             k_end: 100,
             step: 5,
             sample_size: 2000,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

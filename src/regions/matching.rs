@@ -85,6 +85,9 @@ pub struct MatchingParams {
     /// 0.860 / 0.853 vs 0.857 / 0.851; per pair they differ on about 1 pair in 10, both
     /// ways). `tests/matching.rs`, `measure_variants_on_benchmark_pairs`.
     pub distance_term: DistanceTerm,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for MatchingParams {
@@ -96,6 +99,7 @@ impl Default for MatchingParams {
             gap_ratio: 0.9,
             max_symmetry_order: 8,
             distance_term: DistanceTerm::Difference,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

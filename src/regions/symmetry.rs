@@ -69,6 +69,9 @@ pub struct SymmetryParams {
     pub method: OneToOneMethod,
     /// Per-pair cost of the whole-assignment energy ([`DistortionCost::Squared`] by default).
     pub cost: DistortionCost,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 /// The cost of one pair of matched pairs in the whole-assignment energy.
@@ -96,6 +99,7 @@ impl Default for SymmetryParams {
             seed: 0x5eed,
             method: OneToOneMethod::WholeAssignment,
             cost: DistortionCost::Squared,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

@@ -32,7 +32,9 @@ pub const POINT_CLOUD_GRAPH_K: usize = 6;
     serde(rename_all = "snake_case")
 )]
 pub enum ShapeKind {
+    /// A triangle mesh (vertices and faces).
     Mesh,
+    /// A point cloud (vertices only; connectivity from a k-nearest-neighbour graph).
     PointCloud,
 }
 
@@ -45,22 +47,46 @@ pub enum ShapeKind {
 )]
 pub enum Warning {
     /// Faces with a repeated corner (zero area by construction) were dropped.
-    DegenerateFacesDropped { count: usize },
+    DegenerateFacesDropped {
+        /// Number of triangles dropped (counted after polygons are split).
+        count: usize,
+    },
     /// Faces with the same three corners as an earlier face were dropped.
-    DuplicateFacesDropped { count: usize },
+    DuplicateFacesDropped {
+        /// Number of triangles dropped (counted after polygons are split).
+        count: usize,
+    },
     /// Polygons with more than three corners were split into triangles.
-    PolygonsTriangulated { count: usize },
+    PolygonsTriangulated {
+        /// Number of input faces with more than three corners.
+        count: usize,
+    },
     /// Vertices used by no face; they take the values of the nearest used vertex.
-    UnreferencedVertices { count: usize },
+    UnreferencedVertices {
+        /// Number of input vertices used by no face.
+        count: usize,
+    },
     /// The surface (or the point cloud's neighbour graph) has several connected pieces.
-    DisconnectedPieces { count: usize },
+    DisconnectedPieces {
+        /// Number of connected pieces (at least 2).
+        count: usize,
+    },
     /// Edges shared by more than two faces (the Laplacian handles them).
-    NonManifoldEdges { count: usize },
+    NonManifoldEdges {
+        /// Number of edges shared by more than two faces.
+        count: usize,
+    },
     /// Neighbouring faces with opposite orientation (the Laplacian does not depend on it; the
     /// pointwise map uses [`Shape::oriented_triangles`]).
-    InconsistentOrientation { edges: usize },
+    InconsistentOrientation {
+        /// Number of edges whose two faces run them in the same direction.
+        edges: usize,
+    },
     /// Faces with (near) zero area but distinct corners; the Laplacian mollifies them.
-    NeedleOrZeroAreaFaces { count: usize },
+    NeedleOrZeroAreaFaces {
+        /// Number of triangles with area below 1e-8 times the mean triangle area.
+        count: usize,
+    },
 }
 
 impl std::fmt::Display for Warning {

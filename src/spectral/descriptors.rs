@@ -20,6 +20,9 @@ pub struct HksParams {
     /// Take the logarithm of the signature (the authors' code does; raw HKS measured better
     /// in the paper's pipeline, docs/decisions.md, "HKS: raw, not log").
     pub log: bool,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for HksParams {
@@ -29,6 +32,7 @@ impl Default for HksParams {
             t_min: 0.03,
             t_max: 0.25,
             log: false,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -87,6 +91,9 @@ pub struct WksParams {
     /// Width of each energy band relative to the log-eigenvalue range divided by the number
     /// of energies (pyFM and Aubry et al. use 7).
     pub variance: f64,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for WksParams {
@@ -94,6 +101,7 @@ impl Default for WksParams {
         WksParams {
             n_energies: 100,
             variance: 7.0,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

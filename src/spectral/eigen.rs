@@ -43,6 +43,9 @@ pub struct EigenParams {
     /// Threads for the dense matrix products (0 = all available). The result does not depend
     /// on it.
     pub threads: usize,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for EigenParams {
@@ -54,6 +57,7 @@ impl Default for EigenParams {
             block_size: 4,
             seed: 0x5eed,
             threads: 0,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

@@ -66,7 +66,10 @@ pub enum FigureKind {
     /// Body, head on a neck, four legs, a tail (dog-like).
     Quadruped,
     /// A round body with `limbs` identical limbs (3..=8), n-fold symmetric in the rest pose.
-    Star { limbs: usize },
+    Star {
+        /// Number of limbs (3..=8).
+        limbs: usize,
+    },
 }
 
 impl FigureKind {
@@ -105,7 +108,9 @@ impl fmt::Display for FigureKind {
 /// their axis and by `limb_thickness` across it. 1.0 is the default body.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Proportions {
+    /// Scale factor of every limb bone along its axis (1.0 = default; finite, > 0).
     pub limb_length: f64,
+    /// Scale factor of every limb bone across its axis (1.0 = default; finite, > 0).
     pub limb_thickness: f64,
 }
 
@@ -121,12 +126,14 @@ impl Default for Proportions {
 /// What figure to make.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FigureSpec {
+    /// Which figure to make.
     pub kind: FigureKind,
     /// 0 = rest pose; `1..n_poses(kind)` are the other poses.
     pub pose: usize,
     /// Wanted number of vertices (500..=200_000); the result is within 15% of it, usually
     /// within a few percent.
     pub target_vertices: usize,
+    /// Body proportions, applied as a deformation of the rest mesh.
     pub proportions: Proportions,
 }
 
@@ -144,7 +151,9 @@ impl Default for FigureSpec {
 /// A closed triangle mesh, outward oriented (counter-clockwise seen from outside).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct FigureMesh {
+    /// Vertex positions (y up, facing +z); vertex `i` is the same body point in every pose.
     pub vertices: Vec<[f64; 3]>,
+    /// Triangles as 0-based indices into `vertices`, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
 }
 

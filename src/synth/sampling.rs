@@ -11,7 +11,9 @@ use crate::{Error, Result};
 /// (the corner of its triangle nearest to the noise-free sample).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SampledCloud {
+    /// The sampled points, noise included.
     pub points: Vec<[f64; 3]>,
+    /// For every point, the 0-based index of the mesh vertex it stands for.
     pub source_vertex: Vec<u32>,
 }
 

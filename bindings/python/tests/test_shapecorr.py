@@ -75,6 +75,9 @@ def test_installed_package_uses_its_packaged_library():
         pytest.skip("only when testing an installed package (tests/run_all.sh sets this)")
     assert "site-packages" in shapecorr.__file__
     assert _lib.LIBRARY_PATH.parent == Path(shapecorr.__file__).resolve().parent
+    # Shipped without debug information (the `dist` profile; issue 17: at most 8 MB).
+    size = _lib.LIBRARY_PATH.stat().st_size
+    assert size <= 8 * 1024 * 1024, f"packaged library is {size / 2**20:.1f} MiB"
 
 
 def run_python(code, **env):

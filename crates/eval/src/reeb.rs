@@ -129,6 +129,7 @@ pub fn hks_function(basis: &Eigenbasis, t: f64) -> Result<Vec<f64>> {
         t_min: t,
         t_max: t,
         log: false,
+        ..Default::default()
     };
     let column = hks(basis, &params)?;
     Ok((0..column.nrows()).map(|v| column[(v, 0)]).collect())
