@@ -37,8 +37,9 @@
 //! ```
 //!
 //! Every per-vertex output is indexed by the caller's input vertices. Direction lives in the
-//! name: `p2p_21[i]` is the vertex of shape 1 matched to vertex `i` of shape 2; `fmap_12`
-//! maps functions on shape 1 to functions on shape 2.
+//! name: `p2p_ba[i]` is the vertex of shape A matched to vertex `i` of shape B; `fmap_ab`
+//! maps functions on shape A to functions on shape B (the C API, Python and the command
+//! line say the same in words: `map_b_to_a`).
 
 // `!(x > 0.0)` is the NaN-rejecting comparison this numerical code means; clippy's rewrite
 // with `partial_cmp` would hide that.

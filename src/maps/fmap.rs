@@ -2,21 +2,21 @@
 //! between functional and pointwise maps, with ZoomOut (Melzi et al. 2019) and spectral ICP
 //! refinement (docs/design.md, step 13; paper section 6.4).
 //!
-//! Conventions (pyFM's): shape 1 is A, shape 2 is B. `fmap_12` is a `k2 x k1` matrix that
-//! maps the spectral coefficients of a function on shape 1 to those of the transported
-//! function on shape 2; `p2p_21[i]` is the vertex of shape 1 matched to vertex `i` of
-//! shape 2. Both eigenbases are M-orthonormal (`Phi^T M Phi = I`), so the coefficients of
+//! Direction lives in the name, as everywhere in the crate: `fmap_ab` is a `k_b x k_a` matrix
+//! that maps the spectral coefficients of a function on shape A to those of the transported
+//! function on shape B; `p2p_ba[i]` is the vertex of shape A matched to vertex `i` of
+//! shape B (pyFM's `FM_12` and `p2p_21` with 1 = A, 2 = B). Both eigenbases are M-orthonormal (`Phi^T M Phi = I`), so the coefficients of
 //! `f` are `Phi^T M f`.
 //!
 //! * [`project`]: spectral coefficients of functions.
-//! * [`solve_fmap`]: `min_C ||C A - B||^2 + w ||C Lambda_1 - Lambda_2 C||^2`, solved row by
+//! * [`solve_fmap`]: `min_C ||C A - B||^2 + w ||C Lambda_a - Lambda_b C||^2`, solved row by
 //!   row (the commutativity term is diagonal in the entries of C).
 //! * [`solve_fmap_commuting`]: the same plus commutativity with operator pairs
 //!   ([`Commutativity`]): [`multiplication_operators`] (Nogneng and Ovsjanikov 2017) and
 //!   [`orientation_operators`] (Ren et al. 2018), by preconditioned conjugate gradients.
-//! * [`fmap_to_p2p`]: nearest neighbours of the rows of `Phi_2` among the rows of
-//!   `Phi_1 C^T`, by a blocked dense search ([`nearest_rows`]).
-//! * [`p2p_to_fmap`]: `C = Phi_2^T M_2 Pi_21 Phi_1`.
+//! * [`fmap_to_p2p`]: nearest neighbours of the rows of `Phi_b` among the rows of
+//!   `Phi_a C^T`, by a blocked dense search ([`nearest_rows`]).
+//! * [`p2p_to_fmap`]: `C = Phi_b^T M_b Pi_ba Phi_a`.
 //! * [`zoomout`]: grow the basis step by step, alternating the two conversions.
 //! * [`icp_refine`]: spectral ICP: alternate conversion and projection of C on the
 //!   orthogonal matrices (on vertex samples, like ZoomOut).
@@ -67,29 +67,29 @@ pub fn project(
     out
 }
 
-/// The functional map `C_12` (`k2 x k1`) minimising
-/// `||C A - B||_F^2 + w ||C Lambda_1 - Lambda_2 C||_F^2`, where `A = coef_1` (`k1 x d`) and
-/// `B = coef_2` (`k2 x d`) hold corresponding descriptors' coefficients and the eigenvalue
+/// The functional map `C_ab` (`k_b x k_a`) minimising
+/// `||C A - B||_F^2 + w ||C Lambda_a - Lambda_b C||_F^2`, where `A = coef_a` (`k_a x d`) and
+/// `B = coef_b` (`k_b x d`) hold corresponding descriptors' coefficients and the eigenvalue
 /// differences are normalised to unit Frobenius norm (as pyFM does, so `w` is scale-free).
-/// Row `i` of C solves `(A A^T + w diag((lambda_1 - lambda_2,i)^2)) c_i = A b_i^T`.
+/// Row `i` of C solves `(A A^T + w diag((lambda_a - lambda_b,i)^2)) c_i = A b_i^T`.
 pub fn solve_fmap(
-    coef_1: MatRef<'_, f64>,
-    coef_2: MatRef<'_, f64>,
-    values_1: &[f64],
-    values_2: &[f64],
+    coef_a: MatRef<'_, f64>,
+    coef_b: MatRef<'_, f64>,
+    values_a: &[f64],
+    values_b: &[f64],
     laplacian_weight: f64,
 ) -> Result<Mat<f64>> {
-    let rows = RowSystems::new(coef_1, coef_2, values_1, values_2, laplacian_weight)?;
-    let (k1, k2) = (coef_1.nrows(), coef_2.nrows());
-    let mut fmap = Mat::<f64>::zeros(k2, k1);
-    for i in 0..k2 {
-        let system = Mat::from_fn(k1, k1, |r, c| rows.entry(i, r, c));
+    let rows = RowSystems::new(coef_a, coef_b, values_a, values_b, laplacian_weight)?;
+    let (k_a, k_b) = (coef_a.nrows(), coef_b.nrows());
+    let mut fmap = Mat::<f64>::zeros(k_b, k_a);
+    for i in 0..k_b {
+        let system = Mat::from_fn(k_a, k_a, |r, c| rows.entry(i, r, c));
         let llt = system.llt(Side::Lower).map_err(|e| Error::Numerical {
             stage: "functional map",
             reason: format!("row {i}: {e:?}"),
         })?;
         let row = llt.solve(rows.rhs.col(i).as_mat());
-        for j in 0..k1 {
+        for j in 0..k_a {
             fmap[(i, j)] = row[(j, 0)];
         }
     }
@@ -160,13 +160,13 @@ pub fn orientation_operators(
             for t in triangles {
                 let v = t.map(|x| x as usize);
                 let s = [0, 1, 2].map(|c| (f[v[(c + 2) % 3]] - f[v[(c + 1) % 3]]) / 6.0);
-                let (r0, r1, r2) = (
+                let (r0, r_a, r_b) = (
                     &rows[v[0] * k..][..k],
                     &rows[v[1] * k..][..k],
                     &rows[v[2] * k..][..k],
                 );
                 for c in 0..k {
-                    sum[c] = s[0] * r0[c] + s[1] * r1[c] + s[2] * r2[c];
+                    sum[c] = s[0] * r0[c] + s[1] * r_a[c] + s[2] * r_b[c];
                 }
                 for &corner in &v {
                     for (w, x) in w_phi[corner * k..][..k].iter_mut().zip(&sum) {
@@ -192,15 +192,15 @@ pub fn orientation_operators(
         .collect()
 }
 
-/// A commutativity term `w sum_f ||C D1_f - D2_f C||_F^2` with operators of corresponding
-/// descriptors on shape 1 (`k1 x k1`) and shape 2 (`k2 x k2`), in the same order:
+/// A commutativity term `w sum_f ||C DA_f - DB_f C||_F^2` with operators of corresponding
+/// descriptors on shape A (`k_a x k_a`) and shape B (`k_b x k_b`), in the same order:
 /// multiplication operators (Nogneng and Ovsjanikov 2017) or orientation operators (Ren
 /// et al. 2018).
 #[derive(Debug, Clone, Copy)]
 pub struct Commutativity<'a> {
-    /// Operators `D1_f` on shape 1 (each `k1 x k1`).
+    /// Operators `DA_f` on shape A (each `k_a x k_a`).
     pub operators_a: &'a [Mat<f64>],
-    /// Operators `D2_f` on shape 2 (each `k2 x k2`), one per operator in `operators_a`.
+    /// Operators `DB_f` on shape B (each `k_b x k_b`), one per operator in `operators_a`.
     pub operators_b: &'a [Mat<f64>],
     /// Weight `w` of the term (finite, >= 0; 0 drops it).
     pub weight: f64,
@@ -212,30 +212,30 @@ const CG_MAX_ITERATIONS: usize = 1000;
 const CG_TOLERANCE: f64 = 1e-9;
 
 /// [`solve_fmap`] with commutativity terms added:
-/// `||C A - B||^2 + w_L ||C Lambda_1 - Lambda_2 C||^2 + sum_terms w sum_f ||C D1_f - D2_f C||^2`.
+/// `||C A - B||^2 + w_L ||C Lambda_a - Lambda_b C||^2 + sum_terms w sum_f ||C DA_f - DB_f C||^2`.
 /// The term couples the rows of C, so the normal equations are solved by conjugate
 /// gradients, preconditioned by the row-wise systems (sequential, hence deterministic).
 pub fn solve_fmap_commuting(
-    coef_1: MatRef<'_, f64>,
-    coef_2: MatRef<'_, f64>,
-    values_1: &[f64],
-    values_2: &[f64],
+    coef_a: MatRef<'_, f64>,
+    coef_b: MatRef<'_, f64>,
+    values_a: &[f64],
+    values_b: &[f64],
     laplacian_weight: f64,
     terms: &[Commutativity<'_>],
 ) -> Result<Mat<f64>> {
-    let (k1, k2) = (coef_1.nrows(), coef_2.nrows());
+    let (k_a, k_b) = (coef_a.nrows(), coef_b.nrows());
     let fits = |ops: &[Mat<f64>], k: usize| ops.iter().all(|d| d.nrows() == k && d.ncols() == k);
     for term in terms {
         let valid = term.operators_a.len() == term.operators_b.len()
-            && fits(term.operators_a, k1)
-            && fits(term.operators_b, k2)
+            && fits(term.operators_a, k_a)
+            && fits(term.operators_b, k_b)
             && term.weight >= 0.0
             && term.weight.is_finite();
         if !valid {
             return Err(Error::InvalidParameter {
                 name: "descriptor operators",
                 reason: format!(
-                    "need as many {k1}x{k1} operators on shape 1 as {k2}x{k2} on shape 2 and a \
+                    "need as many {k_a}x{k_a} operators on shape A as {k_b}x{k_b} on shape B and a \
                      finite weight >= 0, got {} and {} with weight {}",
                     term.operators_a.len(),
                     term.operators_b.len(),
@@ -249,11 +249,11 @@ pub fn solve_fmap_commuting(
         .filter(|t| t.weight > 0.0 && !t.operators_a.is_empty())
         .collect();
     if terms.is_empty() {
-        return solve_fmap(coef_1, coef_2, values_1, values_2, laplacian_weight);
+        return solve_fmap(coef_a, coef_b, values_a, values_b, laplacian_weight);
     }
-    let rows = RowSystems::new(coef_1, coef_2, values_1, values_2, laplacian_weight)?;
+    let rows = RowSystems::new(coef_a, coef_b, values_a, values_b, laplacian_weight)?;
     // Sum over the terms of w D_a D_a^T and w D_b^T D_b.
-    let (mut s_a, mut s_b) = (Mat::<f64>::zeros(k1, k1), Mat::<f64>::zeros(k2, k2));
+    let (mut s_a, mut s_b) = (Mat::<f64>::zeros(k_a, k_a), Mat::<f64>::zeros(k_b, k_b));
     for term in &terms {
         for (d_a, d_b) in term.operators_a.iter().zip(term.operators_b) {
             matmul(
@@ -280,7 +280,7 @@ pub fn solve_fmap_commuting(
         let mut out = rows.apply(x);
         matmul(out.as_mut(), Accum::Add, x, &s_a, 1.0, Par::Seq);
         matmul(out.as_mut(), Accum::Add, &s_b, x, 1.0, Par::Seq);
-        let mut tmp = Mat::<f64>::zeros(k2, k1);
+        let mut tmp = Mat::<f64>::zeros(k_b, k_a);
         for term in &terms {
             for (d_a, d_b) in term.operators_a.iter().zip(term.operators_b) {
                 matmul(tmp.as_mut(), Accum::Replace, d_b, x, 1.0, Par::Seq);
@@ -306,9 +306,9 @@ pub fn solve_fmap_commuting(
         out
     };
     // Preconditioner: each row's system with the coupling dropped.
-    let factors = (0..k2)
+    let factors = (0..k_b)
         .map(|i| {
-            let system = Mat::from_fn(k1, k1, |r, c| {
+            let system = Mat::from_fn(k_a, k_a, |r, c| {
                 rows.entry(i, r, c) + s_a[(r, c)] + if r == c { s_b[(i, i)] } else { 0.0 }
             });
             system.llt(Side::Lower).map_err(|e| Error::Numerical {
@@ -318,18 +318,18 @@ pub fn solve_fmap_commuting(
         })
         .collect::<Result<Vec<_>>>()?;
     let precondition = |r: &Mat<f64>| -> Mat<f64> {
-        let mut z = Mat::<f64>::zeros(k2, k1);
+        let mut z = Mat::<f64>::zeros(k_b, k_a);
         for (i, llt) in factors.iter().enumerate() {
             let row = llt.solve(r.row(i).transpose().as_mat());
-            for j in 0..k1 {
+            for j in 0..k_a {
                 z[(i, j)] = row[(j, 0)];
             }
         }
         z
     };
     let dot = |a: &Mat<f64>, b: &Mat<f64>| -> f64 {
-        (0..k1)
-            .map(|j| (0..k2).map(|i| a[(i, j)] * b[(i, j)]).sum::<f64>())
+        (0..k_a)
+            .map(|j| (0..k_b).map(|i| a[(i, j)] * b[(i, j)]).sum::<f64>())
             .sum()
     };
     let rhs = rows.rhs();
@@ -358,64 +358,64 @@ pub fn solve_fmap_commuting(
 
 /// The row-separable part of the functional-map energy: `||C A - B||^2` and the Laplacian
 /// commutativity, whose normal equations for row `i` of C are
-/// `(A A^T + w diag((lambda_1 - lambda_2,i)^2)) c_i = A b_i^T`.
+/// `(A A^T + w diag((lambda_a - lambda_b,i)^2)) c_i = A b_i^T`.
 struct RowSystems {
     gram: Mat<f64>,
-    /// `A B^T` (`k1 x k2`): column `i` is row `i`'s right-hand side.
+    /// `A B^T` (`k_a x k_b`): column `i` is row `i`'s right-hand side.
     rhs: Mat<f64>,
-    /// `w (lambda_1,j - lambda_2,i)^2 / norm + ridge`, indexed `(i, j)`.
+    /// `w (lambda_a,j - lambda_b,i)^2 / norm + ridge`, indexed `(i, j)`.
     diagonal: Mat<f64>,
 }
 
 impl RowSystems {
     fn new(
-        coef_1: MatRef<'_, f64>,
-        coef_2: MatRef<'_, f64>,
-        values_1: &[f64],
-        values_2: &[f64],
+        coef_a: MatRef<'_, f64>,
+        coef_b: MatRef<'_, f64>,
+        values_a: &[f64],
+        values_b: &[f64],
         laplacian_weight: f64,
     ) -> Result<RowSystems> {
-        let (k1, k2, d) = (coef_1.nrows(), coef_2.nrows(), coef_1.ncols());
-        if coef_2.ncols() != d || values_1.len() < k1 || values_2.len() < k2 {
+        let (k_a, k_b, d) = (coef_a.nrows(), coef_b.nrows(), coef_a.ncols());
+        if coef_b.ncols() != d || values_a.len() < k_a || values_b.len() < k_b {
             return Err(Error::InvalidParameter {
                 name: "descriptors",
                 reason: format!(
-                    "coefficients {k1}x{d} and {k2}x{} with {} and {} eigenvalues do not fit",
-                    coef_2.ncols(),
-                    values_1.len(),
-                    values_2.len()
+                    "coefficients {k_a}x{d} and {k_b}x{} with {} and {} eigenvalues do not fit",
+                    coef_b.ncols(),
+                    values_a.len(),
+                    values_b.len()
                 ),
             });
         }
-        let sq = |i: usize, j: usize| (values_1[j] - values_2[i]).powi(2);
-        let norm = (0..k2)
-            .flat_map(|i| (0..k1).map(move |j| (i, j)))
+        let sq = |i: usize, j: usize| (values_a[j] - values_b[i]).powi(2);
+        let norm = (0..k_b)
+            .flat_map(|i| (0..k_a).map(move |j| (i, j)))
             .map(|(i, j)| sq(i, j).powi(2))
             .sum::<f64>()
             .sqrt()
             .max(f64::MIN_POSITIVE);
-        let mut gram = Mat::<f64>::zeros(k1, k1);
+        let mut gram = Mat::<f64>::zeros(k_a, k_a);
         matmul(
             gram.as_mut(),
             Accum::Replace,
-            coef_1,
-            coef_1.transpose(),
+            coef_a,
+            coef_a.transpose(),
             1.0,
             Par::Seq,
         );
-        let mut rhs = Mat::<f64>::zeros(k1, k2);
+        let mut rhs = Mat::<f64>::zeros(k_a, k_b);
         matmul(
             rhs.as_mut(),
             Accum::Replace,
-            coef_1,
-            coef_2.transpose(),
+            coef_a,
+            coef_b.transpose(),
             1.0,
             Par::Seq,
         );
         // A tiny ridge keeps every row's system positive definite when the descriptors do
         // not span the basis and w = 0.
-        let ridge = 1e-10 * (0..k1).map(|j| gram[(j, j)]).sum::<f64>().max(1e-300) / k1 as f64;
-        let diagonal = Mat::from_fn(k2, k1, |i, j| laplacian_weight * sq(i, j) / norm + ridge);
+        let ridge = 1e-10 * (0..k_a).map(|j| gram[(j, j)]).sum::<f64>().max(1e-300) / k_a as f64;
+        let diagonal = Mat::from_fn(k_b, k_a, |i, j| laplacian_weight * sq(i, j) / norm + ridge);
         Ok(RowSystems {
             gram,
             rhs,
@@ -428,12 +428,12 @@ impl RowSystems {
         self.gram[(r, c)] + if r == c { self.diagonal[(i, r)] } else { 0.0 }
     }
 
-    /// The right-hand sides as a `k2 x k1` matrix (row `i` for row `i` of C).
+    /// The right-hand sides as a `k_b x k_a` matrix (row `i` for row `i` of C).
     fn rhs(&self) -> Mat<f64> {
         self.rhs.transpose().to_owned()
     }
 
-    /// `X G + diagonal o X` for a `k2 x k1` matrix X.
+    /// `X G + diagonal o X` for a `k_b x k_a` matrix X.
     fn apply(&self, x: &Mat<f64>) -> Mat<f64> {
         let mut out = Mat::from_fn(x.nrows(), x.ncols(), |i, j| {
             self.diagonal[(i, j)] * x[(i, j)]
@@ -573,39 +573,39 @@ fn offer(best: &mut [(f32, u32); RERANK], j: usize, d: f32) {
     }
 }
 
-/// The pointwise map `p2p_21` of a functional map `fmap_12` (`k2 x k1`): every vertex of
-/// shape 2 (row of `phi_2[:, :k2]`) goes to the vertex of shape 1 whose row of
-/// `phi_1[:, :k1] C^T` is nearest.
+/// The pointwise map `p2p_ba` of a functional map `fmap_ab` (`k_b x k_a`): every vertex of
+/// shape B (row of `phi_b[:, :k_b]`) goes to the vertex of shape A whose row of
+/// `phi_a[:, :k_a] C^T` is nearest.
 pub fn fmap_to_p2p(
-    fmap_12: MatRef<'_, f64>,
-    phi_1: MatRef<'_, f64>,
-    phi_2: MatRef<'_, f64>,
+    fmap_ab: MatRef<'_, f64>,
+    phi_a: MatRef<'_, f64>,
+    phi_b: MatRef<'_, f64>,
 ) -> Vec<u32> {
-    let (k2, k1) = (fmap_12.nrows(), fmap_12.ncols());
-    let mut embedding_1 = Mat::<f64>::zeros(phi_1.nrows(), k2);
+    let (k_b, k_a) = (fmap_ab.nrows(), fmap_ab.ncols());
+    let mut embedding_a = Mat::<f64>::zeros(phi_a.nrows(), k_b);
     matmul(
-        embedding_1.as_mut(),
+        embedding_a.as_mut(),
         Accum::Replace,
-        phi_1.subcols(0, k1),
-        fmap_12.transpose(),
+        phi_a.subcols(0, k_a),
+        fmap_ab.transpose(),
         1.0,
         Par::Seq,
     );
-    nearest_rows(embedding_1.as_ref(), phi_2.subcols(0, k2))
+    nearest_rows(embedding_a.as_ref(), phi_b.subcols(0, k_b))
 }
 
-/// The functional map `C_12 = Phi_2^T M_2 Pi_21 Phi_1` (`k2 x k1`) of a pointwise map
-/// `p2p_21` (one vertex of shape 1 per vertex of shape 2).
+/// The functional map `C_ab = Phi_b^T M_b Pi_ba Phi_a` (`k_b x k_a`) of a pointwise map
+/// `p2p_ba` (one vertex of shape A per vertex of shape B).
 pub fn p2p_to_fmap(
-    p2p_21: &[u32],
-    phi_1: MatRef<'_, f64>,
-    phi_2: MatRef<'_, f64>,
-    mass_2: &[f64],
-    k1: usize,
-    k2: usize,
+    p2p_ba: &[u32],
+    phi_a: MatRef<'_, f64>,
+    phi_b: MatRef<'_, f64>,
+    mass_b: &[f64],
+    k_a: usize,
+    k_b: usize,
 ) -> Mat<f64> {
-    let pulled = Mat::from_fn(p2p_21.len(), k1, |i, j| phi_1[(p2p_21[i] as usize, j)]);
-    project(phi_2, mass_2, k2, pulled.as_ref())
+    let pulled = Mat::from_fn(p2p_ba.len(), k_a, |i, j| phi_a[(p2p_ba[i] as usize, j)]);
+    project(phi_b, mass_b, k_b, pulled.as_ref())
 }
 
 /// A sub-sample on which ZoomOut runs (the "fast ZoomOut" of Magnet and Ovsjanikov 2021):
@@ -697,20 +697,20 @@ impl Default for ZoomOutParams {
     }
 }
 
-/// ZoomOut: starting from `fmap_12` (`k x k`), repeatedly convert to a pointwise map and back
-/// with `k + step` eigenfunctions until `k_end`; returns the final `fmap_12` and the
-/// full-resolution `p2p_21`.
+/// ZoomOut: starting from `fmap_ab` (`k x k`), repeatedly convert to a pointwise map and back
+/// with `k + step` eigenfunctions until `k_end`; returns the final `fmap_ab` and the
+/// full-resolution `p2p_ba`.
 pub fn zoomout(
-    fmap_12: MatRef<'_, f64>,
-    phi_1: MatRef<'_, f64>,
-    mass_1: &[f64],
-    phi_2: MatRef<'_, f64>,
-    mass_2: &[f64],
+    fmap_ab: MatRef<'_, f64>,
+    phi_a: MatRef<'_, f64>,
+    mass_a: &[f64],
+    phi_b: MatRef<'_, f64>,
+    mass_b: &[f64],
     params: &ZoomOutParams,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
-    let run = ZoomOutRun::new(fmap_12, phi_1, mass_1, phi_2, mass_2, params)?;
-    let p2p_21 = fmap_to_p2p(run.fmap_12.as_ref(), phi_1, phi_2);
-    Ok((run.fmap_12, p2p_21))
+    let run = ZoomOutRun::new(fmap_ab, phi_a, mass_a, phi_b, mass_b, params)?;
+    let p2p_ba = fmap_to_p2p(run.fmap_ab.as_ref(), phi_a, phi_b);
+    Ok((run.fmap_ab, p2p_ba))
 }
 
 /// ZoomOut's iterations without the final full-resolution conversion: the final functional
@@ -718,118 +718,118 @@ pub fn zoomout(
 #[derive(Debug, Clone)]
 pub struct SampledZoomOut {
     /// The final functional map (`k_end x k_end`).
-    pub fmap_12: Mat<f64>,
-    /// The vertices of shape 1 on which the iterations ran.
-    pub sample_1: Sample,
-    /// The vertices of shape 2 on which the iterations ran.
-    pub sample_2: Sample,
-    /// For every vertex of `sample_2`, its vertex of shape 1 (one of `sample_1`'s) under the
+    pub fmap_ab: Mat<f64>,
+    /// The vertices of shape A on which the iterations ran.
+    pub sample_a: Sample,
+    /// The vertices of shape B on which the iterations ran.
+    pub sample_b: Sample,
+    /// For every vertex of `sample_b`, its vertex of shape A (one of `sample_a`'s) under the
     /// final map.
-    pub p2p_21: Vec<u32>,
+    pub p2p_ba: Vec<u32>,
 }
 
 /// [`zoomout`] up to, not including, the full-resolution conversion (for comparing
 /// candidate maps before paying for it).
 pub fn zoomout_on_samples(
-    fmap_12: MatRef<'_, f64>,
-    phi_1: MatRef<'_, f64>,
-    mass_1: &[f64],
-    phi_2: MatRef<'_, f64>,
-    mass_2: &[f64],
+    fmap_ab: MatRef<'_, f64>,
+    phi_a: MatRef<'_, f64>,
+    mass_a: &[f64],
+    phi_b: MatRef<'_, f64>,
+    mass_b: &[f64],
     params: &ZoomOutParams,
 ) -> Result<SampledZoomOut> {
-    let run = ZoomOutRun::new(fmap_12, phi_1, mass_1, phi_2, mass_2, params)?;
-    let p2p_sub = fmap_to_p2p(run.fmap_12.as_ref(), run.sub_1.as_ref(), run.sub_2.as_ref());
+    let run = ZoomOutRun::new(fmap_ab, phi_a, mass_a, phi_b, mass_b, params)?;
+    let p2p_sub = fmap_to_p2p(run.fmap_ab.as_ref(), run.sub_a.as_ref(), run.sub_b.as_ref());
     Ok(SampledZoomOut {
-        p2p_21: run.sample_1.on_vertices(&p2p_sub),
-        fmap_12: run.fmap_12,
-        sample_1: run.sample_1,
-        sample_2: run.sample_2,
+        p2p_ba: run.sample_a.on_vertices(&p2p_sub),
+        fmap_ab: run.fmap_ab,
+        sample_a: run.sample_a,
+        sample_b: run.sample_b,
     })
 }
 
 /// ZoomOut's iterations on the samples.
 struct ZoomOutRun {
-    fmap_12: Mat<f64>,
-    sample_1: Sample,
-    sample_2: Sample,
+    fmap_ab: Mat<f64>,
+    sample_a: Sample,
+    sample_b: Sample,
     /// The samples' rows of the bases (first `k_end` columns).
-    sub_1: Mat<f64>,
-    sub_2: Mat<f64>,
+    sub_a: Mat<f64>,
+    sub_b: Mat<f64>,
 }
 
 impl ZoomOutRun {
     fn new(
-        fmap_12: MatRef<'_, f64>,
-        phi_1: MatRef<'_, f64>,
-        mass_1: &[f64],
-        phi_2: MatRef<'_, f64>,
-        mass_2: &[f64],
+        fmap_ab: MatRef<'_, f64>,
+        phi_a: MatRef<'_, f64>,
+        mass_a: &[f64],
+        phi_b: MatRef<'_, f64>,
+        mass_b: &[f64],
         params: &ZoomOutParams,
     ) -> Result<ZoomOutRun> {
-        let k_max = phi_1.ncols().min(phi_2.ncols());
+        let k_max = phi_a.ncols().min(phi_b.ncols());
         if params.step == 0
             || params.k_end > k_max
-            || params.k_end < fmap_12.nrows().min(fmap_12.ncols())
+            || params.k_end < fmap_ab.nrows().min(fmap_ab.ncols())
         {
             return Err(Error::InvalidParameter {
                 name: "zoomout",
                 reason: format!(
                     "need step >= 1 and start ({}) <= k_end ({}) <= eigenpairs ({k_max})",
-                    fmap_12.nrows().min(fmap_12.ncols()),
+                    fmap_ab.nrows().min(fmap_ab.ncols()),
                     params.k_end
                 ),
             });
         }
-        let sample_1 = Sample::of_size(mass_1, params.sample_size, SAMPLE_SEED);
-        let sample_2 = Sample::of_size(mass_2, params.sample_size, SAMPLE_SEED + 1);
-        let sub_1 = sample_1.rows(phi_1, params.k_end);
-        let sub_2 = sample_2.rows(phi_2, params.k_end);
-        let mut fmap = fmap_12.to_owned();
+        let sample_a = Sample::of_size(mass_a, params.sample_size, SAMPLE_SEED);
+        let sample_b = Sample::of_size(mass_b, params.sample_size, SAMPLE_SEED + 1);
+        let sub_a = sample_a.rows(phi_a, params.k_end);
+        let sub_b = sample_b.rows(phi_b, params.k_end);
+        let mut fmap = fmap_ab.to_owned();
         let mut k = fmap.nrows().min(fmap.ncols());
         while k < params.k_end {
             // Pointwise map on the samples with the current map, then the functional map one
             // step larger from it.
-            let p2p_sub = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
+            let p2p_sub = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref());
             k = (k + params.step).min(params.k_end);
             fmap = weighted_fmap(
-                &sample_1.on_vertices(&p2p_sub),
-                phi_1,
-                sub_2.as_ref(),
-                &sample_2.weights,
+                &sample_a.on_vertices(&p2p_sub),
+                phi_a,
+                sub_b.as_ref(),
+                &sample_b.weights,
                 k,
             )?;
         }
         Ok(ZoomOutRun {
-            fmap_12: fmap,
-            sample_1,
-            sample_2,
-            sub_1,
-            sub_2,
+            fmap_ab: fmap,
+            sample_a,
+            sample_b,
+            sub_a,
+            sub_b,
         })
     }
 }
 
-/// `C_12 (k x k)` from a pointwise map given on sample rows of shape 2: the weighted least
-/// squares `min_C sum_i w_i |Phi_2[i] C - Phi_1[p2p(i)]|^2`, which is exactly
-/// `Phi_2^T M_2 Pi Phi_1` when the sample is every vertex weighted by its mass.
+/// `C_ab (k x k)` from a pointwise map given on sample rows of shape B: the weighted least
+/// squares `min_C sum_i w_i |Phi_b[i] C - Phi_a[p2p(i)]|^2`, which is exactly
+/// `Phi_b^T M_b Pi Phi_a` when the sample is every vertex weighted by its mass.
 fn weighted_fmap(
-    p2p_21: &[u32],
-    phi_1: MatRef<'_, f64>,
-    rows_2: MatRef<'_, f64>,
+    p2p_ba: &[u32],
+    phi_a: MatRef<'_, f64>,
+    rows_b: MatRef<'_, f64>,
     weights: &[f64],
     k: usize,
 ) -> Result<Mat<f64>> {
-    let m = p2p_21.len();
-    let pulled = Mat::from_fn(m, k, |i, j| phi_1[(p2p_21[i] as usize, j)]);
-    let rows_2 = rows_2.subcols(0, k);
-    let weighted = Mat::from_fn(m, k, |i, j| weights[i] * rows_2[(i, j)]);
+    let m = p2p_ba.len();
+    let pulled = Mat::from_fn(m, k, |i, j| phi_a[(p2p_ba[i] as usize, j)]);
+    let rows_b = rows_b.subcols(0, k);
+    let weighted = Mat::from_fn(m, k, |i, j| weights[i] * rows_b[(i, j)]);
     let mut gram = Mat::<f64>::zeros(k, k);
     matmul(
         gram.as_mut(),
         Accum::Replace,
         weighted.transpose(),
-        rows_2,
+        rows_b,
         1.0,
         Par::Seq,
     );
@@ -855,40 +855,40 @@ fn weighted_fmap(
 /// the orthogonal matrix nearest to the functional map of that pointwise map, for
 /// `iterations` rounds or until the map stops changing. Like [`zoomout`], the rounds run on
 /// seeded vertex samples of `sample_size` per shape (0 = every vertex), then one
-/// full-resolution conversion. Returns `fmap_12` and `p2p_21`.
+/// full-resolution conversion. Returns `fmap_ab` and `p2p_ba`.
 pub fn icp_refine(
-    fmap_12: MatRef<'_, f64>,
-    phi_1: MatRef<'_, f64>,
-    mass_1: &[f64],
-    phi_2: MatRef<'_, f64>,
-    mass_2: &[f64],
+    fmap_ab: MatRef<'_, f64>,
+    phi_a: MatRef<'_, f64>,
+    mass_a: &[f64],
+    phi_b: MatRef<'_, f64>,
+    mass_b: &[f64],
     iterations: usize,
     sample_size: usize,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
-    let (k2, k1) = (fmap_12.nrows(), fmap_12.ncols());
-    if k1 != k2 || k1 > phi_1.ncols().min(phi_2.ncols()) {
+    let (k_b, k_a) = (fmap_ab.nrows(), fmap_ab.ncols());
+    if k_a != k_b || k_a > phi_a.ncols().min(phi_b.ncols()) {
         return Err(Error::InvalidParameter {
             name: "icp",
             reason: format!(
-                "need a square map no larger than the bases ({} and {}), got {k2}x{k1}",
-                phi_1.ncols(),
-                phi_2.ncols()
+                "need a square map no larger than the bases ({} and {}), got {k_b}x{k_a}",
+                phi_a.ncols(),
+                phi_b.ncols()
             ),
         });
     }
-    let sample_1 = Sample::of_size(mass_1, sample_size, SAMPLE_SEED);
-    let sample_2 = Sample::of_size(mass_2, sample_size, SAMPLE_SEED + 1);
-    let (sub_1, sub_2) = (sample_1.rows(phi_1, k1), sample_2.rows(phi_2, k2));
-    let mut fmap = fmap_12.to_owned();
-    let mut p2p = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
+    let sample_a = Sample::of_size(mass_a, sample_size, SAMPLE_SEED);
+    let sample_b = Sample::of_size(mass_b, sample_size, SAMPLE_SEED + 1);
+    let (sub_a, sub_b) = (sample_a.rows(phi_a, k_a), sample_b.rows(phi_b, k_b));
+    let mut fmap = fmap_ab.to_owned();
+    let mut p2p = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref());
     for _ in 0..iterations {
-        let vertices = sample_1.on_vertices(&p2p);
-        let c = weighted_fmap(&vertices, phi_1, sub_2.as_ref(), &sample_2.weights, k1)?;
+        let vertices = sample_a.on_vertices(&p2p);
+        let c = weighted_fmap(&vertices, phi_a, sub_b.as_ref(), &sample_b.weights, k_a)?;
         let svd = c.svd().map_err(|e| Error::Numerical {
             stage: "spectral ICP",
             reason: format!("{e:?}"),
         })?;
-        let mut next = Mat::<f64>::zeros(k2, k1);
+        let mut next = Mat::<f64>::zeros(k_b, k_a);
         matmul(
             next.as_mut(),
             Accum::Replace,
@@ -898,13 +898,13 @@ pub fn icp_refine(
             Par::Seq,
         );
         fmap = next;
-        let next_p2p = fmap_to_p2p(fmap.as_ref(), sub_1.as_ref(), sub_2.as_ref());
+        let next_p2p = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref());
         let unchanged = next_p2p == p2p;
         p2p = next_p2p;
         if unchanged {
             break;
         }
     }
-    let p2p_21 = fmap_to_p2p(fmap.as_ref(), phi_1, phi_2);
-    Ok((fmap, p2p_21))
+    let p2p_ba = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b);
+    Ok((fmap, p2p_ba))
 }

@@ -320,7 +320,7 @@ impl PointwiseMap {
                 let triangles_b = sample_triangles(
                     b.vertices(),
                     &vertex_normals(b.vertices(), faces_b),
-                    &sampled[0].sample_2.vertices,
+                    &sampled[0].sample_b.vertices,
                 );
                 let normals_a = vertex_normals(a.vertices(), faces_a);
                 let score: Vec<f64> = sampled
@@ -340,7 +340,7 @@ impl PointwiseMap {
                         .iter()
                         .zip(&mut full)
                         .map(|(s, slot)| {
-                            let p2p = fmap_to_p2p(s.fmap_12.as_ref(), phi_a, phi_b);
+                            let p2p = fmap_to_p2p(s.fmap_ab.as_ref(), phi_a, phi_b);
                             let covered = covered_vertices(&p2p, a.n_vertices()) as f64;
                             let kept = orientation_kept((a.vertices(), &normals_a), faces_b, &p2p);
                             *slot = Some(p2p);
@@ -351,7 +351,7 @@ impl PointwiseMap {
                 }
                 match &params.refinement {
                     Refinement::ZoomOut(_) => {
-                        let fmap = sampled.swap_remove(best).fmap_12;
+                        let fmap = sampled.swap_remove(best).fmap_ab;
                         let p2p = full
                             .swap_remove(best)
                             .unwrap_or_else(|| fmap_to_p2p(fmap.as_ref(), phi_a, phi_b));
@@ -649,11 +649,11 @@ fn sample_consistency(
     triangles_b: &[([usize; 3], bool)],
     sampled: &SampledZoomOut,
 ) -> f64 {
-    let coverage = covered_vertices(&sampled.p2p_21, va.len()) as f64
-        / sampled.sample_1.vertices.len().max(1) as f64;
+    let coverage = covered_vertices(&sampled.p2p_ba, va.len()) as f64
+        / sampled.sample_a.vertices.len().max(1) as f64;
     let (mut kept, mut total) = (0usize, 0usize);
     for (corners, counter_clockwise) in triangles_b {
-        let images = corners.map(|c| sampled.p2p_21[c] as usize);
+        let images = corners.map(|c| sampled.p2p_ba[c] as usize);
         let turn = signed_turn(va, images, normals_a);
         if turn != 0.0 {
             total += 1;
