@@ -23,11 +23,11 @@
 //! command line `shapecorr-cli` (`crates/cli`).
 //!
 //! ```no_run
-//! use shapecorr::{Correspondence, NoProgress, Params, Shape};
+//! use shapecorr::{Correspondence, NoProgress, Params, ReadAs, Shape};
 //!
 //! # fn main() -> shapecorr::Result<()> {
-//! let a = Shape::read("a.ply".as_ref(), false)?; // validated, input order kept
-//! let b = Shape::read("b.off".as_ref(), false)?;
+//! let a = Shape::read("a.ply".as_ref(), ReadAs::Auto)?; // validated, input order kept
+//! let b = Shape::read("b.off".as_ref(), ReadAs::Auto)?;
 //! let result = Correspondence::compute(&a, &b, &Params::default(), &mut NoProgress)?;
 //! println!("k = {}, matches {:?}", result.k, result.matches_one_to_one);
 //! let region_of_vertex_7_of_a = result.regions_a()[7];
@@ -64,7 +64,7 @@ pub use correspondence::{Correspondence, Params, Symmetry};
 pub use error::{Error, Result};
 pub use maps::pointwise::{PointwiseCorrespondence, PointwiseParams};
 pub use progress::{NoProgress, Progress, Stage};
-pub use shape::{Shape, ShapeKind, Warning};
+pub use shape::{ReadAs, Shape, ShapeKind, Warning};
 pub use spectral::eigen::{EigenParams, Eigenbasis};
 
 /// The hidden last field of every params struct (faer's pattern): callers outside the crate

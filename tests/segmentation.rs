@@ -20,6 +20,7 @@ use shapecorr::regions::segmentation::{
 };
 use shapecorr::spectral::descriptors::{hks, HksParams};
 use shapecorr::synth::{figure, figure_poses, FigureKind, FigureSpec, Proportions};
+use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Shape};
 
 // ---------------------------------------------------------------------------------------
@@ -835,7 +836,7 @@ fn faust_shapes(pairs: &[(usize, usize)], noise: Option<f64>) -> Option<HashMap<
     for &id in &ids {
         let path = dir.join(format!("tr_reg_{id:03}.ply"));
         let t = Instant::now();
-        let mut shape = Shape::read(&path, noise.is_some()).unwrap();
+        let mut shape = Shape::read(&path, ReadAs::point_cloud_when(noise.is_some())).unwrap();
         if let Some(noise) = noise {
             let mut r = rng(id as u64);
             let shift = noise * shape.width();

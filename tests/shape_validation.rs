@@ -3,6 +3,7 @@
 mod common;
 
 use common::icosphere;
+use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Error, Shape, Warning};
 
 fn sphere() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
@@ -256,7 +257,7 @@ fn malformed_files_give_file_errors_naming_the_file() {
     for (name, bytes) in cases {
         let path = dir.join(name);
         std::fs::write(&path, bytes).unwrap();
-        let err = Shape::read(&path, false).unwrap_err();
+        let err = Shape::read(&path, ReadAs::Auto).unwrap_err();
         assert!(matches!(err, Error::File { .. }), "{name}: {err:?}");
         assert!(err.to_string().contains(name), "{name}: {err}");
     }
@@ -269,7 +270,7 @@ fn malformed_files_give_file_errors_naming_the_file() {
     text.push_str("3 0 1 40\n");
     std::fs::write(&path, text).unwrap();
     assert!(matches!(
-        Shape::read(&path, false),
+        Shape::read(&path, ReadAs::Auto),
         Err(Error::FaceIndexOutOfRange { index: 40, .. })
     ));
     std::fs::remove_dir_all(&dir).ok();

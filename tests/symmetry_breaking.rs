@@ -18,6 +18,7 @@ use shapecorr::regions::symmetry::{
     SymmetryParams,
 };
 use shapecorr::synth::{figure_poses, FigureKind, Proportions};
+use shapecorr::ReadAs;
 use shapecorr::{Error, Shape};
 
 // ---------------------------------------------------------------------------------------
@@ -739,7 +740,7 @@ fn region_distance_matrix_on_benchmark_shapes() {
         let Some(path) = benchmark_file(relative) else {
             continue;
         };
-        let shape = Shape::read(&path, false).unwrap();
+        let shape = Shape::read(&path, ReadAs::Auto).unwrap();
         let (mass, area) = vertex_mass(&shape);
         let labels = voronoi_labels(&shape, 16);
         let start = Instant::now();

@@ -7,7 +7,7 @@ use super::boundary::{
     write_output, Failure, FfiResult, ScStatus,
 };
 use crate::synth::{self, FigureKind, FigureSpec, Proportions};
-use crate::{Shape, ShapeKind};
+use crate::{ReadAs, Shape, ShapeKind};
 
 /// A shape: a triangle mesh or a point cloud, validated. Immutable after creation: one
 /// handle may be used from several threads at once (e.g. in concurrent `sc_match` calls).
@@ -145,7 +145,10 @@ pub unsafe extern "C" fn sc_shape_read(
     boundary(|| {
         check_out(out_shape, "out_shape")?;
         let path = input_str(path, "path")?;
-        let shape = Shape::read(std::path::Path::new(path), as_point_cloud)?;
+        let shape = Shape::read(
+            std::path::Path::new(path),
+            ReadAs::point_cloud_when(as_point_cloud),
+        )?;
         give_handle(out_shape, ScShape { shape })
     })
 }

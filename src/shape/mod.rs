@@ -24,6 +24,29 @@ pub const MIN_VERTICES: usize = 32;
 /// Neighbours per point in the point-cloud connectivity graph (paper, section 6.3: k = 6).
 pub const POINT_CLOUD_GRAPH_K: usize = 6;
 
+/// How [`Shape::read`] treats a file's faces.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ReadAs {
+    /// A mesh when the file has faces, a point cloud when it has none.
+    #[default]
+    Auto,
+    /// A point cloud: the faces, if any, are ignored.
+    PointCloud,
+}
+
+impl ReadAs {
+    /// [`ReadAs::PointCloud`] when `points` is set (a front end's "treat as points" switch),
+    /// else [`ReadAs::Auto`].
+    pub fn point_cloud_when(points: bool) -> ReadAs {
+        if points {
+            ReadAs::PointCloud
+        } else {
+            ReadAs::Auto
+        }
+    }
+}
+
 /// Whether a shape is a triangle mesh or a point cloud.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(
@@ -156,19 +179,19 @@ impl Shape {
         Shape::build(vertices, &[], ShapeKind::PointCloud)
     }
 
-    /// A shape from a file's contents: a point cloud when it has no faces or when
-    /// `as_point_cloud` is set, a mesh otherwise.
-    pub fn from_raw(raw: RawShape, as_point_cloud: bool) -> Result<Shape> {
-        if as_point_cloud || raw.polygons.is_empty() {
+    /// A shape from a file's contents: a point cloud when it has no faces or when `read_as`
+    /// says so, a mesh otherwise.
+    pub fn from_raw(raw: RawShape, read_as: ReadAs) -> Result<Shape> {
+        if read_as == ReadAs::PointCloud || raw.polygons.is_empty() {
             Shape::point_cloud(raw.vertices)
         } else {
             Shape::mesh_from_polygons(raw.vertices, &raw.polygons)
         }
     }
 
-    /// Reads a file (OFF, OBJ, PLY, XYZ/PTS) into a shape.
-    pub fn read(path: &std::path::Path, as_point_cloud: bool) -> Result<Shape> {
-        Shape::from_raw(crate::shape::io::read_shape(path)?, as_point_cloud)
+    /// Reads a file (OFF, OBJ, PLY, XYZ/PTS) into a shape: `Shape::read(path, ReadAs::Auto)`.
+    pub fn read(path: &std::path::Path, read_as: ReadAs) -> Result<Shape> {
+        Shape::from_raw(crate::shape::io::read_shape(path)?, read_as)
     }
 
     fn build(vertices: Vec<[f64; 3]>, polygons: &[&[u32]], kind: ShapeKind) -> Result<Shape> {

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use shapecorr::geodesic::HeatGeodesics;
+use shapecorr::ReadAs;
 use shapecorr::Shape;
 
 fn main() -> shapecorr::Result<()> {
@@ -22,7 +23,7 @@ fn main() -> shapecorr::Result<()> {
     }
     const SOURCES: usize = 10;
     for file in files {
-        let shape = Shape::read(&file, false)?;
+        let shape = Shape::read(&file, ReadAs::Auto)?;
         let t = Instant::now();
         let solver = HeatGeodesics::new(&shape)?;
         let setup = t.elapsed().as_secs_f64();

@@ -31,6 +31,7 @@ use shapecorr::maps::pointwise::{PointwiseCorrespondence, PointwiseParams, Point
 use shapecorr::progress::NoProgress;
 use shapecorr::shape::Shape;
 use shapecorr::spectral::eigen::EigenParams;
+use shapecorr::ReadAs;
 use shapecorr::{Error, Result};
 
 /// What `bench all` runs and where it writes.
@@ -439,8 +440,8 @@ fn run_clouds(
         results.len(),
     );
     for pair in &chosen {
-        let a = Shape::read(&dataset.shape_path(&pair.source)?, false)?;
-        let b = Shape::read(&dataset.shape_path(&pair.target)?, false)?;
+        let a = Shape::read(&dataset.shape_path(&pair.source)?, ReadAs::Auto)?;
+        let b = Shape::read(&dataset.shape_path(&pair.target)?, ReadAs::Auto)?;
         let (truth, flipped) =
             dataset.ground_truth(&pair.source, &pair.target, a.n_vertices(), b.n_vertices())?;
         let finished: Vec<(String, usize, u64, usize)> = results
@@ -513,8 +514,8 @@ fn run_timing(
         &chosen,
         &|r: &TimingRecord| (r.pair.source.clone(), r.pair.target.clone()),
         &mut |pair| {
-            let a = Shape::read(&dataset.shape_path(&pair.source)?, false)?;
-            let b = Shape::read(&dataset.shape_path(&pair.target)?, false)?;
+            let a = Shape::read(&dataset.shape_path(&pair.source)?, ReadAs::Auto)?;
+            let b = Shape::read(&dataset.shape_path(&pair.target)?, ReadAs::Auto)?;
             let regions = Correspondence::compute(&a, &b, &p.params, &mut NoProgress)?;
             let pointwise =
                 PointwiseCorrespondence::compute(&a, &b, &p.params, &p.pointwise, &mut NoProgress)?;

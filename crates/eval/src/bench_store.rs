@@ -21,6 +21,7 @@ use crate::datasets::Dataset;
 use shapecorr::geodesic::HeatGeodesics;
 use shapecorr::shape::Shape;
 use shapecorr::spectral::eigen::{EigenParams, Eigenbasis};
+use shapecorr::ReadAs;
 use shapecorr::{Error, Result};
 
 /// Version of the cache file format and of the eigensolver's output: bump it when either
@@ -197,7 +198,7 @@ impl ShapeStore {
     pub fn load(&mut self, name: &str, basis: bool, heat: bool) -> Result<&StoredShape> {
         if !self.shapes.contains_key(name) {
             let path = self.dataset.shape_path(name)?;
-            let shape = Shape::read(&path, false)?;
+            let shape = Shape::read(&path, ReadAs::Auto)?;
             self.shapes.insert(
                 name.to_string(),
                 StoredShape {

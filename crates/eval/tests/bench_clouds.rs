@@ -10,6 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::score;
 use shapecorr::synth::{self, FigureKind, Proportions};
+use shapecorr::ReadAs;
 use shapecorr::{Error, NoProgress, Shape};
 use shapecorr_eval::bench_clouds::{
     cloud_figure, cloud_seed, cloud_table, cloud_trials, largest_extent, sample_cloud,
@@ -543,7 +544,7 @@ fn faust_pair_quick_check() {
         println!("no {}", root.display());
         return;
     }
-    let read = |name: &str| Shape::read(&root.join(format!("{name}.ply")), false).unwrap();
+    let read = |name: &str| Shape::read(&root.join(format!("{name}.ply")), ReadAs::Auto).unwrap();
     let (a, b) = (read("tr_reg_000"), read("tr_reg_009"));
     let mirror: Vec<u32> = std::fs::read_to_string(root.join("template_mirror.txt"))
         .unwrap()

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use shapecorr::synth::{figure_poses, FigureKind, Proportions};
+use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Shape};
 use shapecorr_eval::bench_store::{BasisCache, ResultLog, ShapeStore};
 use shapecorr_eval::datasets::{discover, read_pairs, Dataset, Layout, Pair};
@@ -93,7 +94,7 @@ fn shared_order_layouts_faust_scape_and_tosca() {
     for d in &found {
         let pairs = read_pairs(&d.pairs_file(&root)).unwrap();
         let p = &pairs[0];
-        let a = Shape::read(&d.shape_path(&p.source).unwrap(), false).unwrap();
+        let a = Shape::read(&d.shape_path(&p.source).unwrap(), ReadAs::Auto).unwrap();
         assert_eq!(a.n_vertices(), n);
         let (truth, flipped) = d.ground_truth(&p.source, &p.target, n, n).unwrap();
         assert_eq!(truth.len(), n);
@@ -160,8 +161,8 @@ fn vts_layout_maps_remeshed_shapes() {
 
     let d = Dataset::open(&root, "shrec_r").unwrap();
     assert_eq!(d.layout, Layout::Vts);
-    let a = Shape::read(&d.shape_path("a").unwrap(), false).unwrap();
-    let b = Shape::read(&d.shape_path("b").unwrap(), false).unwrap();
+    let a = Shape::read(&d.shape_path("a").unwrap(), ReadAs::Auto).unwrap();
+    let b = Shape::read(&d.shape_path("b").unwrap(), ReadAs::Auto).unwrap();
     let (truth, flipped) = d
         .ground_truth("a", "b", a.n_vertices(), b.n_vertices())
         .unwrap();
@@ -255,7 +256,7 @@ fn eigenbasis_cache_returns_the_same_basis_and_survives_damage() {
     let mesh = &poses()[0];
     let path = root.join("shape.ply");
     shapecorr::shape::io::write_ply(&path, &mesh.vertices, &mesh.triangles, None).unwrap();
-    let shape = Shape::read(&path, false).unwrap();
+    let shape = Shape::read(&path, ReadAs::Auto).unwrap();
     let params = EigenParams {
         n_eigenpairs: 20,
         ..EigenParams::default()

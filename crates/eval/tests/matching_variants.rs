@@ -6,6 +6,7 @@ use std::time::Instant;
 use shapecorr::regions::matching::{
     distance_histograms, leading_eigenvector, unary_costs, Affinity, DistanceTerm, MatchingParams,
 };
+use shapecorr::ReadAs;
 
 /// Real-data measurement: benchmark pairs (`SHAPECORR_DATA` or `../shared/data`; the list
 /// `pairs/$MATCHING_DATASET.txt`, default `faust`), segmented by the default pipeline,
@@ -67,7 +68,7 @@ fn measure_variants_on_benchmark_pairs() {
         cache
             .entry(name.to_string())
             .or_insert_with(|| {
-                let shape = Shape::read(&dataset.shape_path(name).unwrap(), false).unwrap();
+                let shape = Shape::read(&dataset.shape_path(name).unwrap(), ReadAs::Auto).unwrap();
                 let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
                 let hks = hks(&basis, &HksParams::default()).unwrap();
                 std::rc::Rc::new(Prepared {

@@ -6,6 +6,7 @@ use shapecorr::correspondence::Params;
 use shapecorr::evaluation::score_correspondence;
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec};
+use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Error, Shape};
 use shapecorr_eval::reeb::{
     hks_function, level_boundaries, level_of, reeb_correspondence, reeb_graph, shape_reeb_graph,
@@ -551,7 +552,7 @@ fn measure_on_benchmark(dataset: &str, names: &[String], mirror_file: &str) {
     let mut shapes = Vec::new();
     for name in names {
         let path = folder.join(format!("{name}.ply"));
-        let shape = Shape::read(&path, false).unwrap_or_else(|e| panic!("{e}"));
+        let shape = Shape::read(&path, ReadAs::Auto).unwrap_or_else(|e| panic!("{e}"));
         let b = Eigenbasis::compute(&shape, &params.eigen).unwrap();
         for levels in [5, 6, 8, 10] {
             let counts: Vec<usize> = [0.0, 0.002, 0.005]
