@@ -209,24 +209,7 @@ impl PointwiseMap {
         params.validate()?;
         let started = Instant::now();
         let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
-        let groups = match params.regions {
-            RegionConstraints::None => Vec::new(),
-            kind => {
-                let regions = regions.ok_or(Error::InvalidParameter {
-                    name: "regions",
-                    reason: "region constraints need a region correspondence".into(),
-                })?;
-                let groups = region_groups(regions, kind);
-                if groups.is_empty() {
-                    return Err(Error::InvalidParameter {
-                        name: "regions",
-                        reason: "the region correspondence has no match to constrain the map"
-                            .into(),
-                    });
-                }
-                groups
-            }
-        };
+        let groups = constraint_groups(regions, params.regions)?;
         // Both shapes' faces consistently oriented (None for point clouds and
         // non-orientable surfaces): the orientation term and the mirror decision need them.
         // A one-to-one region answer may be the mirror image of the truth (paper, section
@@ -263,104 +246,12 @@ impl PointwiseMap {
             .collect::<Result<Vec<_>>>()?;
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
-        // ZoomOut up to what both bases have, and at least the first map's size.
-        let clamped = |z: &ZoomOutParams| ZoomOutParams {
-            k_end: z.k_end.min(basis_a.len()).min(basis_b.len()).max(k),
-            ..z.clone()
-        };
-        let refine = |fmap: &Mat<f64>| -> Result<(Mat<f64>, Vec<u32>)> {
-            match &params.refinement {
-                Refinement::None => Ok((fmap.clone(), fmap_to_p2p(fmap.as_ref(), phi_a, phi_b))),
-                Refinement::ZoomOut(z) => zoomout(
-                    fmap.as_ref(),
-                    phi_a,
-                    &basis_a.mass,
-                    phi_b,
-                    &basis_b.mass,
-                    &clamped(z),
-                ),
-                Refinement::Icp(iterations) => icp_refine(
-                    fmap.as_ref(),
-                    phi_a,
-                    &basis_a.mass,
-                    phi_b,
-                    &basis_b.mass,
-                    *iterations,
-                    ZoomOutParams::default().sample_size,
-                ),
-            }
-        };
         let (fmap_ab, p2p_ba) = match &faces {
-            Some((faces_a, faces_b)) if fmaps.len() > 1 => {
-                // The answer and its mirror image, each refined by ZoomOut on the samples.
-                // The orientation term makes the candidate whose regions agree with the
-                // orientation a consistent map, and the other a compromise that folds part
-                // of the shape onto itself or turns it over: it reaches fewer of A's
-                // samples, or keeps the orientation of fewer triangles. Only the winner is
-                // converted at full resolution.
-                let decision = match &params.refinement {
-                    Refinement::ZoomOut(z) => z.clone(),
-                    _ => ZoomOutParams::default(),
-                };
-                let mut sampled = fmaps
-                    .iter()
-                    .map(|fmap| {
-                        zoomout_on_samples(
-                            fmap.as_ref(),
-                            phi_a,
-                            &basis_a.mass,
-                            phi_b,
-                            &basis_b.mass,
-                            &clamped(&decision),
-                        )
-                    })
-                    .collect::<Result<Vec<_>>>()?;
-                // Every candidate ran on the same samples (fixed seeds).
-                let triangles_b = sample_triangles(
-                    b.vertices(),
-                    &vertex_normals(b.vertices(), faces_b),
-                    &sampled[0].sample_b.vertices,
-                );
-                let normals_a = vertex_normals(a.vertices(), faces_a);
-                let score: Vec<f64> = sampled
-                    .iter()
-                    .map(|s| sample_consistency((a.vertices(), &normals_a), &triangles_b, s))
-                    .collect();
-                let mut best = argmax(&score);
-                let runner_up = (0..score.len())
-                    .filter(|&c| c != best)
-                    .map(|c| score[c])
-                    .fold(0.0, f64::max);
-                // A close call is decided at full resolution: every candidate converted,
-                // A's vertices reached times B's triangles keeping their orientation.
-                let mut full: Vec<Option<Vec<u32>>> = vec![None; sampled.len()];
-                if score[best] < CLOSE_CALL * runner_up {
-                    let full_score: Vec<f64> = sampled
-                        .iter()
-                        .zip(&mut full)
-                        .map(|(s, slot)| {
-                            let p2p = fmap_to_p2p(s.fmap_ab.as_ref(), phi_a, phi_b);
-                            let covered = covered_vertices(&p2p, a.n_vertices()) as f64;
-                            let kept = orientation_kept((a.vertices(), &normals_a), faces_b, &p2p);
-                            *slot = Some(p2p);
-                            covered * kept.unwrap_or(0.0)
-                        })
-                        .collect();
-                    best = argmax(&full_score);
-                }
-                match &params.refinement {
-                    Refinement::ZoomOut(_) => {
-                        let fmap = sampled.swap_remove(best).fmap_ab;
-                        let p2p = full
-                            .swap_remove(best)
-                            .unwrap_or_else(|| fmap_to_p2p(fmap.as_ref(), phi_a, phi_b));
-                        (fmap, p2p)
-                    }
-                    _ => refine(&fmaps[best])?,
-                }
+            Some(faces) if fmaps.len() > 1 => {
+                let bases = (basis_a, basis_b);
+                orientation_winner((a, b), bases, faces, &fmaps, params, k)?
             }
-            _ => refine(&fmaps[0])?,
+            _ => refine(&fmaps[0], (basis_a, basis_b), params, k)?,
         };
         Ok(PointwiseMap {
             p2p_ba,
@@ -371,6 +262,151 @@ impl PointwiseMap {
             },
         })
     }
+}
+
+/// The region constraints of the map: the groups of matched regions (none for
+/// [`RegionConstraints::None`]).
+fn constraint_groups(
+    regions: Option<&Correspondence>,
+    kind: RegionConstraints,
+) -> Result<Vec<(Vec<u32>, Vec<u32>)>> {
+    if kind == RegionConstraints::None {
+        return Ok(Vec::new());
+    }
+    let regions = regions.ok_or(Error::InvalidParameter {
+        name: "regions",
+        reason: "region constraints need a region correspondence".into(),
+    })?;
+    let groups = region_groups(regions, kind);
+    if groups.is_empty() {
+        return Err(Error::InvalidParameter {
+            name: "regions",
+            reason: "the region correspondence has no match to constrain the map".into(),
+        });
+    }
+    Ok(groups)
+}
+
+/// ZoomOut's settings up to what both bases have, and at least the first map's size `k`.
+fn clamped(
+    z: &ZoomOutParams,
+    (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
+    k: usize,
+) -> ZoomOutParams {
+    ZoomOutParams {
+        k_end: z.k_end.min(basis_a.len()).min(basis_b.len()).max(k),
+        ..z.clone()
+    }
+}
+
+/// The chosen refinement of one functional map: the refined map and its vertex map.
+fn refine(
+    fmap: &Mat<f64>,
+    (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
+    params: &PointwiseParams,
+    k: usize,
+) -> Result<(Mat<f64>, Vec<u32>)> {
+    let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+    match &params.refinement {
+        Refinement::None => Ok((fmap.clone(), fmap_to_p2p(fmap.as_ref(), phi_a, phi_b))),
+        Refinement::ZoomOut(z) => zoomout(
+            fmap.as_ref(),
+            phi_a,
+            &basis_a.mass,
+            phi_b,
+            &basis_b.mass,
+            &clamped(z, (basis_a, basis_b), k),
+        ),
+        Refinement::Icp(iterations) => icp_refine(
+            fmap.as_ref(),
+            phi_a,
+            &basis_a.mass,
+            phi_b,
+            &basis_b.mass,
+            *iterations,
+            ZoomOutParams::default().sample_size,
+        ),
+    }
+}
+
+/// The candidate functional maps `fmaps` (the answer and its mirror image) decided by
+/// orientation on consistently oriented meshes (`faces` of A and B), refined: the final map
+/// and its vertex map.
+fn orientation_winner(
+    (a, b): (&Shape, &Shape),
+    (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
+    (faces_a, faces_b): &(Vec<[u32; 3]>, Vec<[u32; 3]>),
+    fmaps: &[Mat<f64>],
+    params: &PointwiseParams,
+    k: usize,
+) -> Result<(Mat<f64>, Vec<u32>)> {
+    let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+    // The answer and its mirror image, each refined by ZoomOut on the samples.
+    // The orientation term makes the candidate whose regions agree with the
+    // orientation a consistent map, and the other a compromise that folds part
+    // of the shape onto itself or turns it over: it reaches fewer of A's
+    // samples, or keeps the orientation of fewer triangles. Only the winner is
+    // converted at full resolution.
+    let decision = match &params.refinement {
+        Refinement::ZoomOut(z) => z.clone(),
+        _ => ZoomOutParams::default(),
+    };
+    let mut sampled = fmaps
+        .iter()
+        .map(|fmap| {
+            zoomout_on_samples(
+                fmap.as_ref(),
+                phi_a,
+                &basis_a.mass,
+                phi_b,
+                &basis_b.mass,
+                &clamped(&decision, (basis_a, basis_b), k),
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    // Every candidate ran on the same samples (fixed seeds).
+    let triangles_b = sample_triangles(
+        b.vertices(),
+        &vertex_normals(b.vertices(), faces_b),
+        &sampled[0].sample_b.vertices,
+    );
+    let normals_a = vertex_normals(a.vertices(), faces_a);
+    let score: Vec<f64> = sampled
+        .iter()
+        .map(|s| sample_consistency((a.vertices(), &normals_a), &triangles_b, s))
+        .collect();
+    let mut best = argmax(&score);
+    let runner_up = (0..score.len())
+        .filter(|&c| c != best)
+        .map(|c| score[c])
+        .fold(0.0, f64::max);
+    // A close call is decided at full resolution: every candidate converted,
+    // A's vertices reached times B's triangles keeping their orientation.
+    let mut full: Vec<Option<Vec<u32>>> = vec![None; sampled.len()];
+    if score[best] < CLOSE_CALL * runner_up {
+        let full_score: Vec<f64> = sampled
+            .iter()
+            .zip(&mut full)
+            .map(|(s, slot)| {
+                let p2p = fmap_to_p2p(s.fmap_ab.as_ref(), phi_a, phi_b);
+                let covered = covered_vertices(&p2p, a.n_vertices()) as f64;
+                let kept = orientation_kept((a.vertices(), &normals_a), faces_b, &p2p);
+                *slot = Some(p2p);
+                covered * kept.unwrap_or(0.0)
+            })
+            .collect();
+        best = argmax(&full_score);
+    }
+    Ok(match &params.refinement {
+        Refinement::ZoomOut(_) => {
+            let fmap = sampled.swap_remove(best).fmap_ab;
+            let p2p = full
+                .swap_remove(best)
+                .unwrap_or_else(|| fmap_to_p2p(fmap.as_ref(), phi_a, phi_b));
+            (fmap, p2p)
+        }
+        _ => refine(&fmaps[best], (basis_a, basis_b), params, k)?,
+    })
 }
 
 /// Number of distinct vertices of A that the map reaches.
