@@ -38,6 +38,7 @@ pub enum RegionConstraints {
 /// How the first functional map is refined.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Refinement {
+    /// The first functional map's vertex map, unrefined.
     None,
     /// ZoomOut (Melzi et al. 2019) up to `k_end` eigenfunctions.
     ZoomOut(ZoomOutParams),
@@ -191,6 +192,7 @@ pub struct PointwiseMap {
     pub p2p_ba: Vec<u32>,
     /// The final functional map from A to B (`k x k`).
     pub fmap_ab: Mat<f64>,
+    /// Seconds of the first functional map and of its refinement.
     pub timings: PointwiseTimings,
 }
 
@@ -856,11 +858,15 @@ fn mirrored_groups(
 /// Everything from two shapes: eigenbases, region correspondence, pointwise map.
 #[derive(Debug, Clone)]
 pub struct PointwiseCorrespondence {
+    /// The region correspondence the map is built on.
     pub regions: Correspondence,
+    /// The point-to-point map from B to A.
     pub map: PointwiseMap,
-    /// Seconds for both eigenbases, the regions, the map, and the whole call.
+    /// Seconds of A's eigenbasis.
     pub eigenbasis_a: f64,
+    /// Seconds of B's eigenbasis.
     pub eigenbasis_b: f64,
+    /// Seconds of the whole call.
     pub total: f64,
 }
 

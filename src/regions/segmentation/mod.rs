@@ -291,10 +291,15 @@ pub struct JointClustering {
 /// One k tried by [`segment_pair`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct KCandidate {
+    /// The number of joint clusters.
     pub k: usize,
+    /// Nodes (regions) of A's shape graph.
     pub n_nodes_a: usize,
+    /// Nodes (regions) of B's shape graph.
     pub n_nodes_b: usize,
+    /// Whether A's shape graph is connected.
     pub connected_a: bool,
+    /// Whether B's shape graph is connected.
     pub connected_b: bool,
     /// Both graphs connected and within `max_regions`.
     pub acceptable: bool,
@@ -309,7 +314,9 @@ pub struct KCandidate {
 pub struct JointSegmentation {
     /// The chosen number of clusters.
     pub k: usize,
+    /// A's shape graph at that k.
     pub graph_a: ShapeGraph,
+    /// B's shape graph at that k.
     pub graph_b: ShapeGraph,
     /// The joint centroids of the chosen k (k x d, in the descriptor space of shape A).
     pub centroids: Mat<f64>,

@@ -335,7 +335,9 @@ fn first_or_second_edges(
 pub struct Regions {
     /// The cluster (Reeb: level interval) of each region.
     pub cluster: Vec<u32>,
+    /// The area of each region (sum of its vertices' mass).
     pub area: Vec<f64>,
+    /// The smallest vertex of each region.
     pub first_vertex: Vec<u32>,
     /// Neighbouring regions and the number of edges shared with each.
     pub neighbours: Vec<BTreeMap<u32, u32>>,
@@ -404,6 +406,7 @@ impl Regions {
         (survivors, node_of_region)
     }
 
+    /// The region that `r` ended up in after merges.
     pub fn resolve(&self, mut r: u32) -> u32 {
         while self.absorbed_into[r as usize] != u32::MAX {
             r = self.absorbed_into[r as usize];
