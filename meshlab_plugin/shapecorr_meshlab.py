@@ -13,6 +13,12 @@ shown by MeshLab's "Colorize by vertex quality") and as the custom attribute
     ms.load_new_mesh("A.ply")
     ms.load_new_mesh("B.ply")
     coloured = shapecorr_meshlab.match_regions(ms)     # a new MeshSet: mesh 0 is A, 1 is B
+
+The command's options are generated from the library's option table
+(``shapecorr.options()``, the same as the ``shapecorr`` command line's): one per region
+option, named as the option with ``-`` for ``_`` (``--k-min 5``, ``--gap-ratio 0.85``,
+``--one-to-one false``), plus ``--set NAME=VALUE`` (repeatable, the table's spelling,
+applied after them).
 """
 
 import argparse
@@ -74,18 +80,94 @@ def match_regions(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, pro
     return out
 
 
-def main(argv=None):
+#: Text read as True and as False for a boolean option (as the command line reads them).
+_TRUE, _FALSE = ("true", "yes", "1"), ("false", "no", "0")
+
+
+def region_options():
+    """The library's region options (the pointwise map's are named ``p2p_*``), as
+    ``(name, type, description, default)``."""
+    return [option for option in shapecorr.options() if not option[0].startswith("p2p_")]
+
+
+def parse_value(name, kind, text):
+    """A value of option ``name`` of type ``kind`` ("int", "float" or "bool") from text."""
+    word = text.strip().lower()
+    try:
+        if kind == "bool":
+            if word in _TRUE or word in _FALSE:
+                return word in _TRUE
+            raise ValueError
+        return int(word) if kind == "int" else float(word)
+    except ValueError:
+        expected = {"int": "an integer", "float": "a number", "bool": "true or false (yes/no, 1/0)"}[kind]
+        raise argparse.ArgumentTypeError(f"option `{name}` expects {expected}, got {text!r}") from None
+
+
+def _option_parser(name, kind):
+    return lambda text: parse_value(name, kind, text)
+
+
+def _set_parser(table):
+    kinds = {name: kind for name, kind, _doc, _default in table}
+
+    def parse(text):
+        name, equals, value = text.partition("=")
+        name = name.strip()
+        if not equals:
+            raise argparse.ArgumentTypeError(f"expected NAME=VALUE (e.g. k_max=8), got {text!r}")
+        if name not in kinds:
+            raise argparse.ArgumentTypeError(f"unknown option `{name}`; the options are: {', '.join(kinds)}")
+        return name, parse_value(name, kinds[name], value)
+
+    return parse
+
+
+def argument_parser():
+    """The command's arguments; the options come from the library's table."""
     parser = argparse.ArgumentParser(description="Colour the matching regions of two meshes (shapecorr).")
     parser.add_argument("a", help="first mesh (any format MeshLab reads)")
     parser.add_argument("b", help="second mesh")
     parser.add_argument("--out-a", required=True, help="coloured copy of A (e.g. A_col.ply)")
     parser.add_argument("--out-b", required=True, help="coloured copy of B")
-    parser.add_argument("--k-min", type=int, help="smallest number of joint clusters")
-    parser.add_argument("--k-max", type=int, help="largest number of joint clusters")
     parser.add_argument("--symmetric", action="store_true", help="colour by symmetric matches (no one-to-one)")
     parser.add_argument("--points", action="store_true", help="treat both as point clouds")
-    args = parser.parse_args(argv)
-    options = {name: value for name, value in (("k_min", args.k_min), ("k_max", args.k_max)) if value is not None}
+    table = region_options()
+    group = parser.add_argument_group("region options (the library's option table)")
+    for name, kind, doc, default in table:
+        metavar = {"int": "INT", "float": "NUMBER", "bool": "true|false"}[kind]
+        shown = str(default).lower() if kind == "bool" else default
+        group.add_argument(
+            "--" + name.replace("_", "-"),
+            dest=f"option:{name}",
+            metavar=metavar,
+            type=_option_parser(name, kind),
+            default=argparse.SUPPRESS,
+            help=f"{doc} (default: {shown})".replace("%", "%%"),
+        )
+    group.add_argument(
+        "--set",
+        dest="set",
+        metavar="NAME=VALUE",
+        action="append",
+        default=[],
+        type=_set_parser(table),
+        help="set any of the options above by its table name (k_max=8), after them; repeatable",
+    )
+    return parser
+
+
+def options_of(args):
+    """The named options given on the command line: the flags, then ``--set``."""
+    options = {key[len("option:"):]: value for key, value in vars(args).items() if key.startswith("option:")}
+    options.update(args.set)
+    return options
+
+
+def main(argv=None):
+    args = argument_parser().parse_args(argv)
+    options = options_of(args)
+    one_to_one = options.pop("one_to_one", True) and not args.symmetric
     ms = pymeshlab.MeshSet()
     try:
         ms.load_new_mesh(str(args.a))
@@ -94,7 +176,7 @@ def main(argv=None):
         print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
         return 1
     try:
-        result = match_regions(ms, one_to_one=not args.symmetric, as_point_cloud=args.points, **options)
+        result = match_regions(ms, one_to_one=one_to_one, as_point_cloud=args.points, **options)
     except shapecorr.ShapecorrError as error:
         print(f"shapecorr_meshlab: {error}", file=sys.stderr)
         return 1

@@ -9,7 +9,9 @@
 //! (integers non-negative and within range, choices among their listed values, floats
 //! finite); the checks that involve several options (`k_min <= k_max`,
 //! `p2p_fmap_size <= p2p_eigenpairs`) are [`Params::validate`]'s and
-//! [`PointwiseParams::validate`]'s.
+//! [`PointwiseParams::validate`]'s. Text front ends (the command line, `--set NAME=VALUE`)
+//! read a value with [`parse_option_value`], which also knows the choices' names
+//! (`p2p_refinement = icp`).
 
 use crate::correspondence::Params;
 use crate::maps::fmap::ZoomOutParams;
@@ -95,6 +97,9 @@ pub const P2P_REGIONS: [RegionConstraints; 3] = [
     RegionConstraints::Symmetric,
 ];
 
+/// The names of `p2p_regions`' choices, by value (0, 1, 2).
+pub const P2P_REGIONS_NAMES: [&str; 3] = ["none", "one-to-one", "symmetric"];
+
 /// `p2p_refinement = 0`: the first functional map's vertex map, unrefined.
 pub const P2P_REFINEMENT_NONE: i64 = 0;
 /// `p2p_refinement = 1`: ZoomOut (`p2p_zoomout_end`, `p2p_zoomout_step`,
@@ -103,8 +108,11 @@ pub const P2P_REFINEMENT_ZOOMOUT: i64 = 1;
 /// `p2p_refinement = 2`: spectral ICP (`p2p_icp_iterations`).
 pub const P2P_REFINEMENT_ICP: i64 = 2;
 
-/// Iterations of spectral ICP when it is chosen by name (`p2p_refinement = 2`; the command
-/// line's `--refine icp` also runs 10).
+/// The names of `p2p_refinement`'s choices, by value (0, 1, 2).
+pub const P2P_REFINEMENT_NAMES: [&str; 3] = ["none", "zoomout", "icp"];
+
+/// Iterations of spectral ICP when it is chosen without more (`p2p_refinement = 2` or
+/// `icp`): the default of `p2p_icp_iterations`.
 pub const ICP_ITERATIONS: usize = 10;
 
 use OptionType::{Bool, Float, Int};
@@ -204,7 +212,7 @@ pub const OPTIONS: &[OptionInfo] = &[
     p2p(
         "p2p_regions",
         Int,
-        "pointwise map: region constraints: 0 none, 1 one-to-one matches, 2 symmetric groups",
+        "pointwise map: region constraints: 0 none, 1 one-to-one (matches), 2 symmetric (groups)",
     ),
     p2p(
         "p2p_region_distances",
@@ -239,7 +247,7 @@ pub const OPTIONS: &[OptionInfo] = &[
     p2p(
         "p2p_refinement",
         Int,
-        "pointwise map: refinement: 0 none, 1 ZoomOut, 2 spectral ICP",
+        "pointwise map: refinement: 0 none, 1 zoomout (ZoomOut), 2 icp (spectral ICP)",
     ),
     p2p(
         "p2p_zoomout_end",
@@ -261,6 +269,11 @@ pub const OPTIONS: &[OptionInfo] = &[
         Int,
         "pointwise map: largest number of spectral ICP iterations",
     ),
+    p2p(
+        "p2p_orientation",
+        Bool,
+        "pointwise map: choose between the answer and its mirror image by orientation (meshes)",
+    ),
 ];
 
 /// The option called `name`.
@@ -276,6 +289,68 @@ pub fn option_info(name: &str) -> Result<&'static OptionInfo> {
                 .collect::<Vec<_>>()
                 .join(", "),
         })
+}
+
+/// The names of the choices of option `name`, by value (`p2p_regions`, `p2p_refinement`);
+/// `None` for an option that is not a choice.
+pub fn option_choices(name: &str) -> Option<&'static [&'static str]> {
+    match name {
+        "p2p_regions" => Some(&P2P_REGIONS_NAMES),
+        "p2p_refinement" => Some(&P2P_REFINEMENT_NAMES),
+        _ => None,
+    }
+}
+
+/// Reads a value of option `name` from text, by the option's type: an integer (a choice
+/// also by its name, see [`option_choices`]; `seed` also as an unsigned 64-bit number), a
+/// float, or a bool as `true`/`false`, `yes`/`no` or `1`/`0` (any case). Errors with
+/// [`Error::UnknownOption`] for a name not in [`OPTIONS`] and with
+/// [`Error::InvalidParameter`] saying what was expected for text that is none of those.
+/// Only the text is checked: the range is [`Options::set_option`]'s.
+pub fn parse_option_value(name: &str, text: &str) -> Result<OptionValue> {
+    let info = option_info(name)?;
+    let trimmed = text.trim();
+    let lower = trimmed.to_ascii_lowercase();
+    let parsed = match info.option_type {
+        OptionType::Int => match option_choices(info.name) {
+            Some(names) => names
+                .iter()
+                .position(|n| *n == lower)
+                .map(|i| i as i64)
+                .or_else(|| trimmed.parse().ok()),
+            None if info.name == "seed" => trimmed
+                .parse()
+                .ok()
+                .or_else(|| trimmed.parse::<u64>().ok().map(|v| v as i64)),
+            None => trimmed.parse().ok(),
+        }
+        .map(OptionValue::Int),
+        OptionType::Float => trimmed.parse().ok().map(OptionValue::Float),
+        OptionType::Bool => match lower.as_str() {
+            "true" | "yes" | "1" => Some(OptionValue::Bool(true)),
+            "false" | "no" | "0" => Some(OptionValue::Bool(false)),
+            _ => None,
+        },
+    };
+    parsed.ok_or_else(|| {
+        let expected = match (info.option_type, option_choices(info.name)) {
+            (OptionType::Int, Some(names)) => {
+                let listed: Vec<String> = names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| format!("{n} ({i})"))
+                    .collect();
+                format!("one of {}", listed.join(", "))
+            }
+            (OptionType::Int, None) => "an integer".to_string(),
+            (OptionType::Float, _) => "a number".to_string(),
+            (OptionType::Bool, _) => "true or false (yes/no, 1/0)".to_string(),
+        };
+        Error::InvalidParameter {
+            name: info.name,
+            reason: format!("expected {expected}, got `{text}`"),
+        }
+    })
 }
 
 fn wrong_type(info: &OptionInfo, got: OptionType) -> Error {
@@ -538,6 +613,7 @@ impl Options {
             OptionValue::Bool(v) => match info.name {
                 "p2p_region_distances" => p.region_distances = v,
                 "p2p_wks" => p.wks = v.then(|| p.wks.clone().unwrap_or_default()),
+                "p2p_orientation" => p.orientation = v,
                 other => unreachable!("bool option {other} has no field"),
             },
         }
@@ -574,6 +650,7 @@ impl Options {
             "p2p_zoomout_step" => int(self.zoomout.step),
             "p2p_zoomout_sample" => int(self.zoomout.sample_size),
             "p2p_icp_iterations" => int(self.icp_iterations),
+            "p2p_orientation" => OptionValue::Bool(p.orientation),
             other => unreachable!("option {other} has no field"),
         })
     }
@@ -756,6 +833,104 @@ mod tests {
             .set_option("p2p_wks", OptionValue::Bool(true))
             .unwrap();
         assert_eq!(options.pointwise().wks, Some(WksParams::default()));
+    }
+
+    #[test]
+    fn text_is_parsed_by_the_option_type() {
+        let parse = |name: &str, text: &str| parse_option_value(name, text).unwrap();
+        assert_eq!(parse("k_min", "7"), OptionValue::Int(7));
+        assert_eq!(parse("k_min", " -1 "), OptionValue::Int(-1)); // the range is set_option's
+        assert_eq!(parse("gap_ratio", "0.85"), OptionValue::Float(0.85));
+        assert_eq!(parse("gap_ratio", "1"), OptionValue::Float(1.0));
+        for (text, value) in [
+            ("true", true),
+            ("Yes", true),
+            ("1", true),
+            ("false", false),
+            ("NO", false),
+            ("0", false),
+        ] {
+            assert_eq!(
+                parse("one_to_one", text),
+                OptionValue::Bool(value),
+                "{text}"
+            );
+        }
+        assert_eq!(
+            parse("seed", "18446744073709551615"),
+            OptionValue::Int(u64::MAX as i64)
+        );
+        assert_eq!(parse("seed", "-7"), OptionValue::Int(-7));
+    }
+
+    #[test]
+    fn choices_are_read_by_name_or_number() {
+        for (names, option) in [
+            (P2P_REGIONS_NAMES, "p2p_regions"),
+            (P2P_REFINEMENT_NAMES, "p2p_refinement"),
+        ] {
+            assert_eq!(option_choices(option), Some(&names[..]));
+            for (i, name) in names.iter().enumerate() {
+                let by_name = parse_option_value(option, name).unwrap();
+                assert_eq!(by_name, OptionValue::Int(i as i64), "{option} = {name}");
+                assert_eq!(parse_option_value(option, &i.to_string()).unwrap(), by_name);
+                assert_eq!(
+                    parse_option_value(option, &name.to_uppercase()).unwrap(),
+                    by_name
+                );
+            }
+        }
+        assert_eq!(option_choices("k_min"), None);
+        let mut options = Options::default();
+        let icp = parse_option_value("p2p_refinement", "icp").unwrap();
+        options.set_option("p2p_refinement", icp).unwrap();
+        assert_eq!(
+            options.pointwise().refinement,
+            Refinement::Icp(ICP_ITERATIONS)
+        );
+        let symmetric = parse_option_value("p2p_regions", "symmetric").unwrap();
+        options.set_option("p2p_regions", symmetric).unwrap();
+        assert_eq!(options.pointwise().regions, RegionConstraints::Symmetric);
+    }
+
+    #[test]
+    fn bad_text_says_what_was_expected() {
+        let reason = |name: &str, text: &str| match parse_option_value(name, text) {
+            Err(Error::InvalidParameter { name: n, reason }) => {
+                assert_eq!(n, name);
+                reason
+            }
+            other => panic!("{name} = {text:?}: {other:?}"),
+        };
+        assert!(reason("k_min", "five").contains("an integer"));
+        assert!(reason("k_min", "2.5").contains("`2.5`"));
+        assert!(reason("gap_ratio", "high").contains("a number"));
+        assert!(reason("one_to_one", "maybe").contains("true or false"));
+        let choice = reason("p2p_refinement", "zoom");
+        assert!(
+            choice.contains("none (0), zoomout (1), icp (2)"),
+            "{choice}"
+        );
+        assert!(reason("p2p_regions", "both").contains("one-to-one (1)"));
+        assert!(matches!(
+            parse_option_value("nope", "1"),
+            Err(Error::UnknownOption { .. })
+        ));
+    }
+
+    #[test]
+    fn orientation_is_the_pointwise_params_switch() {
+        let last = OPTIONS.last().unwrap();
+        assert_eq!((last.name, last.option_type), ("p2p_orientation", Bool));
+        let mut options = Options::default();
+        assert_eq!(
+            options.option("p2p_orientation").unwrap(),
+            OptionValue::Bool(true)
+        );
+        options
+            .set_option("p2p_orientation", OptionValue::Bool(false))
+            .unwrap();
+        assert!(!options.pointwise().orientation);
     }
 
     #[test]

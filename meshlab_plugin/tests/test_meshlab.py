@@ -1,6 +1,7 @@
 """The MeshLab script with pymeshlab from PyPI, on generated figures: as a function on a
 MeshSet, as a command on PLY files, on an STL file (which pymeshlab reads and the library's
-own reader does not), and on bad input."""
+own reader does not), and on bad input; its command-line options come from the library's
+option table."""
 
 import subprocess
 import sys
@@ -100,3 +101,25 @@ def test_bad_input_exits_with_a_reason(tmp_path):
     missing = run_script(tmp_path / "nothing.ply", tmp_path / "b.ply", "--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply")
     assert missing.returncode == 1 and "cannot load" in missing.stderr
     assert not (tmp_path / "x.ply").exists()
+
+
+def test_command_options_are_the_library_table():
+    parser = shapecorr_meshlab.argument_parser()
+    flags = {flag for action in parser._actions for flag in action.option_strings}
+    region = [name for name, *_ in shapecorr.options() if not name.startswith("p2p_")]
+    assert region and all("--" + name.replace("_", "-") in flags for name in region)
+    assert not any(flag.startswith("--p2p-") for flag in flags)
+    base = ["a.ply", "b.ply", "--out-a", "x.ply", "--out-b", "y.ply"]
+    by_flag = shapecorr_meshlab.options_of(parser.parse_args(base + ["--k-max", "8", "--one-to-one", "no"]))
+    by_set = shapecorr_meshlab.options_of(parser.parse_args(base + ["--set", "k_max=8", "--set", "one_to_one=false"]))
+    assert by_flag == by_set == {"k_max": 8, "one_to_one": False}
+    # --set comes after the flags.
+    later = shapecorr_meshlab.options_of(parser.parse_args(base + ["--set", "k_max=7", "--k-max", "9"]))
+    assert later == {"k_max": 7}
+    assert shapecorr_meshlab.options_of(parser.parse_args(base)) == {}
+
+
+def test_bad_options_exit_with_a_reason(tmp_path):
+    for args, expected in ((["--set", "nope=1"], "nope"), (["--k-min", "five"], "k_min"), (["--gap-ratio", "x"], "gap_ratio")):
+        done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply", *args)
+        assert done.returncode == 2 and expected in done.stderr, (args, done.stderr)

@@ -367,3 +367,198 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The `--long` flags in a command's help, without the ones every command has.
+fn help_flags(args: &[&str]) -> std::collections::BTreeSet<String> {
+    let out = shapecorr(args);
+    assert!(out.status.success(), "{args:?}");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+        .filter(|w| w.starts_with("--") && w.len() > 2)
+        .map(str::to_string)
+        .collect()
+}
+
+fn flag(name: &str) -> String {
+    format!("--{}", name.replace('_', "-"))
+}
+
+/// Every option of the library's table is a flag of `p2p` and `bench p2p`; `match`,
+/// `symmetry` and `bench regions` have exactly the region ones.
+#[test]
+fn help_lists_one_flag_per_option_of_the_table() {
+    use shapecorr::options::{OptionGroup, OPTIONS};
+    for command in [&["p2p", "--help"][..], &["bench", "p2p", "--help"]] {
+        let flags = help_flags(command);
+        for info in OPTIONS {
+            assert!(
+                flags.contains(&flag(info.name)),
+                "{command:?}: {}",
+                info.name
+            );
+        }
+        assert!(flags.contains("--set") && flags.contains("--region-times"));
+    }
+    let region: std::collections::BTreeSet<String> = OPTIONS
+        .iter()
+        .filter(|o| o.group == OptionGroup::Regions)
+        .map(|o| flag(o.name))
+        .collect();
+    for (command, own) in [
+        (&["match", "--help"][..], &["--out", "--points"][..]),
+        (&["symmetry", "--help"], &["--out", "--points"]),
+        (
+            &["bench", "regions", "--help"],
+            &["--data", "--pairs", "--limit"],
+        ),
+    ] {
+        let mut flags = help_flags(command);
+        for f in own.iter().chain(&["--set", "--help"]) {
+            assert!(flags.remove(*f), "{command:?}: {f}");
+        }
+        assert_eq!(flags, region, "{command:?}");
+    }
+    // The help carries the table's doc and the library's default.
+    let out = shapecorr(&["match", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    let k_max = OPTIONS.iter().find(|o| o.name == "k_max").unwrap();
+    assert!(help.contains(k_max.doc), "{help}");
+    assert!(help.contains("[default: 10]"), "{help}");
+}
+
+/// `--set k_max=6` and `--k-max 6` reach the method alike: the same options recorded in
+/// result.json (k_max 6, the rest the library's defaults), the same regions, k within 5..=6.
+#[test]
+fn set_and_the_flag_set_the_same_option() {
+    use shapecorr::options::{OptionGroup, OptionValue, Options, OPTIONS};
+    let dir = scratch("set");
+    let a = dir.join("a.ply");
+    let b = dir.join("b.ply");
+    for (path, pose) in [(&a, "0"), (&b, "2")] {
+        let out = shapecorr(&[
+            "synth",
+            "--kind",
+            "star4",
+            "--pose",
+            pose,
+            "--vertices",
+            "1500",
+            "--out",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success());
+    }
+    let run = |name: &str, extra: &[&str]| -> serde_json::Value {
+        let out_dir = dir.join(name);
+        let mut args = vec![
+            "match",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let out = shapecorr(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("result.json")).unwrap())
+            .unwrap()
+    };
+    let by_set = run("set", &["--set", "k_max=6"]);
+    let by_flag = run("flag", &["--k-max", "6"]);
+    assert_eq!(by_set["options"], by_flag["options"]);
+    let defaults = Options::default();
+    let options = by_set["options"].as_object().unwrap();
+    for info in OPTIONS.iter().filter(|o| o.group == OptionGroup::Regions) {
+        let expected = match (info.name, defaults.option(info.name).unwrap()) {
+            ("k_max", _) => serde_json::json!(6),
+            (_, OptionValue::Int(v)) => serde_json::json!(v),
+            (_, OptionValue::Float(v)) => serde_json::json!(v),
+            (_, OptionValue::Bool(v)) => serde_json::json!(v),
+        };
+        assert_eq!(options[info.name], expected, "{}", info.name);
+    }
+    assert_eq!(
+        options.len(),
+        OPTIONS
+            .iter()
+            .filter(|o| o.group == OptionGroup::Regions)
+            .count()
+    );
+    for result in [&by_set, &by_flag] {
+        let k = result["k"].as_u64().unwrap();
+        assert!((5..=6).contains(&k), "k = {k}");
+    }
+    assert_eq!(by_set["regions_a"], by_flag["regions_a"]);
+    assert_eq!(by_set["matches"], by_flag["matches"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Unknown or misplaced options and bad values fail before any work, naming the option.
+#[test]
+fn bad_options_exit_non_zero_naming_the_option() {
+    for (args, expected) in [
+        (
+            &["match", "a.ply", "b.ply", "--out", "x", "--set", "nope=1"][..],
+            "nope",
+        ),
+        (
+            &["p2p", "a.ply", "b.ply", "--out", "x", "--set", "nope=1"],
+            "nope",
+        ),
+        (
+            &[
+                "match",
+                "a.ply",
+                "b.ply",
+                "--out",
+                "x",
+                "--set",
+                "p2p_fmap_size=30",
+            ],
+            "p2p_fmap_size",
+        ),
+        (
+            &["match", "a.ply", "b.ply", "--out", "x", "--k-min", "five"],
+            "--k-min",
+        ),
+        (
+            &[
+                "p2p",
+                "a.ply",
+                "b.ply",
+                "--out",
+                "x",
+                "--p2p-refinement",
+                "zoom",
+            ],
+            "zoomout",
+        ),
+        (
+            &["symmetry", "a.ply", "--out", "x", "--one-to-one", "maybe"],
+            "--one-to-one",
+        ),
+    ] {
+        let out = shapecorr(args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    // Options valid alone but not together: the one-line reason of every command.
+    let out = shapecorr(&[
+        "match", "a.ply", "b.ply", "--out", "x", "--k-min", "8", "--k-max", "5",
+    ]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("shapecorr: ") && stderr.trim_end().lines().count() == 1,
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("k_min") || stderr.contains("k_max"),
+        "{stderr}"
+    );
+}

@@ -1,0 +1,60 @@
+//! `shapecorr info`: counts, area, pieces and warnings of a shape file.
+
+use std::path::PathBuf;
+
+use serde_json::json;
+use shapecorr::spectral::laplacian::Laplacian;
+use shapecorr::{Error, Shape, ShapeKind};
+
+#[derive(clap::Args)]
+pub struct InfoArgs {
+    file: PathBuf,
+    /// Treat the file as a point cloud even if it has faces.
+    #[arg(long)]
+    points: bool,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+impl InfoArgs {
+    pub fn run(&self) -> Result<(), Error> {
+        let file = &self.file;
+        let shape = Shape::read(file, self.points)?;
+        let laplacian = Laplacian::new(&shape)?;
+        let warnings: Vec<String> = shape.warnings().iter().map(|w| w.to_string()).collect();
+        let kind = match shape.kind() {
+            ShapeKind::Mesh => "mesh",
+            ShapeKind::PointCloud => "point cloud",
+        };
+        if self.json {
+            let value = json!({
+                "file": file,
+                "kind": shape.kind(),
+                "n_vertices": shape.n_vertices(),
+                "n_faces": shape.triangles().len(),
+                "n_used_vertices": shape.active_vertices().len(),
+                "area": laplacian.input_area,
+                "width": shape.width(),
+                "n_pieces": shape.n_pieces(),
+                "warnings": warnings,
+            });
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&value).unwrap_or_default()
+            );
+        } else {
+            println!("file:        {}", file.display());
+            println!("kind:        {kind}");
+            println!("vertices:    {}", shape.n_vertices());
+            println!("faces:       {}", shape.triangles().len());
+            println!("area:        {:.6}", laplacian.input_area);
+            println!("width:       {:.6}", shape.width());
+            println!("pieces:      {}", shape.n_pieces());
+            for w in warnings {
+                println!("warning:     {w}");
+            }
+        }
+        Ok(())
+    }
+}

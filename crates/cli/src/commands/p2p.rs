@@ -1,0 +1,71 @@
+//! `shapecorr p2p`: the point-to-point map from B to A (regions, functional map, ZoomOut).
+
+use std::path::PathBuf;
+
+use serde_json::json;
+use shapecorr::maps::pointwise::PointwiseCorrespondence;
+use shapecorr::{Error, Shape};
+
+use crate::options::PointwiseOptions;
+use crate::output::{
+    correspondence_json, create_dir, end_progress_line, options_json, write_colored, write_json,
+    write_map, write_map_colors, TerminalProgress,
+};
+
+#[derive(clap::Args)]
+pub struct P2pArgs {
+    a: PathBuf,
+    b: PathBuf,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long)]
+    points: bool,
+    #[command(flatten)]
+    options: PointwiseOptions,
+}
+
+impl P2pArgs {
+    pub fn run(&self) -> Result<(), Error> {
+        let (options, pointwise) = self.options.pointwise()?;
+        let shape_a = Shape::read(&self.a, self.points)?;
+        let shape_b = Shape::read(&self.b, self.points)?;
+        let out = &self.out;
+        create_dir(out)?;
+        let result = PointwiseCorrespondence::compute(
+            &shape_a,
+            &shape_b,
+            &options.params,
+            &pointwise,
+            &mut TerminalProgress,
+        );
+        end_progress_line();
+        let result = result?;
+        let map = &result.map.p2p_ba;
+        write_map(&out.join("map_b_to_a.txt"), map)?;
+        let mut value = correspondence_json(&shape_a, &shape_b, &result.regions);
+        value["timings_s"] = json!({
+            "eigenbasis_a": result.eigenbasis_a,
+            "eigenbasis_b": result.eigenbasis_b,
+            "regions": result.regions.timings,
+            "pointwise": result.map.timings,
+            "total": result.total,
+        });
+        value["fmap_size"] = json!(result.map.fmap_ab.nrows());
+        value["options"] = options_json(&options, true);
+        value["region_times"] = json!(pointwise.region_times);
+        write_json(&out.join("result.json"), &value)?;
+        write_colored(out, &shape_a, &shape_b, &result.regions)?;
+        write_map_colors(out, &shape_a, &shape_b, map)?;
+        println!(
+            "map of {} vertices of B onto A ({} one-to-one region matches, functional map {}x{}); {:.2} s -> {}",
+            map.len(),
+            result.regions.matches_one_to_one.len(),
+            result.map.fmap_ab.nrows(),
+            result.map.fmap_ab.ncols(),
+            result.total,
+            out.display()
+        );
+        Ok(())
+    }
+}

@@ -1,0 +1,108 @@
+//! `shapecorr match` (region correspondence of two shapes) and `shapecorr symmetry` (the
+//! symmetric regions of one shape).
+
+use std::path::PathBuf;
+
+use serde_json::json;
+use shapecorr::correspondence::{Correspondence, Symmetry};
+use shapecorr::{Error, Shape};
+
+use crate::options::RegionOptions;
+use crate::output::{
+    correspondence_json, create_dir, end_progress_line, graph_json, options_json, write_colored,
+    write_json, TerminalProgress,
+};
+
+#[derive(clap::Args)]
+pub struct MatchArgs {
+    a: PathBuf,
+    b: PathBuf,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Treat both files as point clouds even if they have faces.
+    #[arg(long)]
+    points: bool,
+    #[command(flatten)]
+    options: RegionOptions,
+}
+
+impl MatchArgs {
+    pub fn run(&self) -> Result<(), Error> {
+        let options = self.options.options()?;
+        let shape_a = Shape::read(&self.a, self.points)?;
+        let shape_b = Shape::read(&self.b, self.points)?;
+        let out = &self.out;
+        create_dir(out)?;
+        let result =
+            Correspondence::compute(&shape_a, &shape_b, &options.params, &mut TerminalProgress);
+        end_progress_line();
+        let result = result?;
+        let mut value = correspondence_json(&shape_a, &shape_b, &result);
+        value["options"] = options_json(&options, false);
+        write_json(&out.join("result.json"), &value)?;
+        write_colored(out, &shape_a, &shape_b, &result)?;
+        println!(
+            "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one; {:.2} s -> {}",
+            result.k,
+            result.graph_a.n_nodes(),
+            result.graph_b.n_nodes(),
+            result.matches.len(),
+            result.matches_one_to_one.len(),
+            result.timings.total,
+            out.display()
+        );
+        Ok(())
+    }
+}
+
+#[derive(clap::Args)]
+pub struct SymmetryArgs {
+    a: PathBuf,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long)]
+    points: bool,
+    #[command(flatten)]
+    options: RegionOptions,
+}
+
+impl SymmetryArgs {
+    pub fn run(&self) -> Result<(), Error> {
+        let options = self.options.options()?;
+        let shape = Shape::read(&self.a, self.points)?;
+        let out = &self.out;
+        create_dir(out)?;
+        let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress);
+        end_progress_line();
+        let symmetry = symmetry?;
+        let colors = symmetry.vertex_colors();
+        shapecorr::shape::io::write_ply(
+            &out.join("a_symmetry.ply"),
+            shape.vertices(),
+            shape.triangles(),
+            Some(&colors),
+        )?;
+        write_json(
+            &out.join("result.json"),
+            &json!({
+                "version": env!("CARGO_PKG_VERSION"),
+                "n_vertices_a": shape.n_vertices(),
+                "regions_a": symmetry.graph.labels,
+                "groups": symmetry.groups,
+                "matches": symmetry.matches,
+                "graph_a": graph_json(&symmetry.graph),
+                "options": options_json(&options, false),
+            }),
+        )?;
+        let symmetric_groups = symmetry.groups.iter().filter(|g| g.len() > 1).count();
+        println!(
+            "{} regions, {} groups of symmetric regions -> {}",
+            symmetry.graph.n_nodes(),
+            symmetric_groups,
+            out.display()
+        );
+        Ok(())
+    }
+}

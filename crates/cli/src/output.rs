@@ -1,0 +1,160 @@
+//! What the commands write: JSON files, coloured PLYs, map files, and the progress line.
+
+use std::path::Path;
+
+use serde_json::json;
+use shapecorr::colors::{coordinate_colors, region_colors};
+use shapecorr::correspondence::Correspondence;
+use shapecorr::options::{OptionGroup, OptionValue, Options, OPTIONS};
+use shapecorr::progress::{Progress, Stage};
+use shapecorr::regions::graph::ShapeGraph;
+use shapecorr::{Error, Shape};
+
+/// Prints stage progress on one line of the terminal (nothing when stderr is not one).
+pub struct TerminalProgress;
+
+impl Progress for TerminalProgress {
+    fn report(&mut self, stage: Stage, fraction: f32) -> bool {
+        use std::io::{IsTerminal, Write};
+        let mut stderr = std::io::stderr();
+        if stderr.is_terminal() {
+            let _ = write!(
+                stderr,
+                "\r{:<16} {:>3.0}%",
+                format!("{stage:?}"),
+                100.0 * fraction
+            );
+            let _ = stderr.flush();
+        }
+        true
+    }
+}
+
+/// Ends the progress line, if one was drawn.
+pub fn end_progress_line() {
+    use std::io::IsTerminal;
+    if std::io::stderr().is_terminal() {
+        eprintln!();
+    }
+}
+
+/// Creates the output folder `out`.
+pub fn create_dir(out: &Path) -> Result<(), Error> {
+    std::fs::create_dir_all(out).map_err(|e| Error::file(out, e.to_string()))
+}
+
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), Error> {
+    let text = serde_json::to_string_pretty(value).unwrap_or_default();
+    std::fs::write(path, text).map_err(|e| Error::file(path, e.to_string()))
+}
+
+/// The value of every option used, by name (the region options, and with `pointwise` the
+/// pointwise map's too): what `result.json` records as `options`.
+pub fn options_json(options: &Options, pointwise: bool) -> serde_json::Value {
+    let values: serde_json::Map<String, serde_json::Value> = OPTIONS
+        .iter()
+        .filter(|o| pointwise || o.group == OptionGroup::Regions)
+        .filter_map(|o| {
+            let value = match options.option(o.name).ok()? {
+                OptionValue::Int(v) => json!(v),
+                OptionValue::Float(v) => json!(v),
+                OptionValue::Bool(v) => json!(v),
+            };
+            Some((o.name.to_string(), value))
+        })
+        .collect();
+    serde_json::Value::Object(values)
+}
+
+pub fn graph_json(graph: &ShapeGraph) -> serde_json::Value {
+    json!({
+        "n_nodes": graph.n_nodes(),
+        "node_area": graph.node_area,
+        "node_cluster": graph.node_cluster,
+        "node_descriptor": graph.node_descriptor,
+        "edges": graph.edges,
+    })
+}
+
+pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> serde_json::Value {
+    json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "n_vertices_a": a.n_vertices(),
+        "n_vertices_b": b.n_vertices(),
+        "kind_a": a.kind(),
+        "kind_b": b.kind(),
+        "k": result.k,
+        "regions_a": result.regions_a(),
+        "regions_b": result.regions_b(),
+        "matches": result.matches,
+        "matches_one_to_one": result.matches_one_to_one,
+        "graph_a": graph_json(&result.graph_a),
+        "graph_b": graph_json(&result.graph_b),
+        "timings_s": result.timings,
+        "warnings_a": a.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
+        "warnings_b": b.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
+    })
+}
+
+/// Writes the coloured PLYs of a correspondence; colours by the one-to-one matches when
+/// there are any, else by the symmetric groups.
+pub fn write_colored(
+    out: &Path,
+    a: &Shape,
+    b: &Shape,
+    result: &Correspondence,
+) -> Result<(), Error> {
+    let pairs = if result.matches_one_to_one.is_empty() {
+        &result.matches
+    } else {
+        &result.matches_one_to_one
+    };
+    let (colors_a, colors_b) = region_colors(
+        result.regions_a(),
+        result.graph_a.n_nodes(),
+        result.regions_b(),
+        result.graph_b.n_nodes(),
+        pairs,
+    );
+    shapecorr::shape::io::write_ply(
+        &out.join("a_regions.ply"),
+        a.vertices(),
+        a.triangles(),
+        Some(&colors_a),
+    )?;
+    shapecorr::shape::io::write_ply(
+        &out.join("b_regions.ply"),
+        b.vertices(),
+        b.triangles(),
+        Some(&colors_b),
+    )
+}
+
+/// Writes `a_colors.ply` (A coloured by its normalised coordinates) and `b_mapped.ply` (B
+/// with A's colours carried over by the map), to look at a map.
+pub fn write_map_colors(out: &Path, a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Result<(), Error> {
+    let colors_a = coordinate_colors(a.vertices());
+    let colors_b: Vec<[u8; 3]> = p2p_ba.iter().map(|&v| colors_a[v as usize]).collect();
+    shapecorr::shape::io::write_ply(
+        &out.join("a_colors.ply"),
+        a.vertices(),
+        a.triangles(),
+        Some(&colors_a),
+    )?;
+    shapecorr::shape::io::write_ply(
+        &out.join("b_mapped.ply"),
+        b.vertices(),
+        b.triangles(),
+        Some(&colors_b),
+    )
+}
+
+/// Writes a map file: one 0-based vertex index per line.
+pub fn write_map(path: &Path, map: &[u32]) -> Result<(), Error> {
+    let mut text = String::with_capacity(map.len() * 6);
+    for v in map {
+        text.push_str(&v.to_string());
+        text.push('\n');
+    }
+    std::fs::write(path, text).map_err(|e| Error::file(path, e.to_string()))
+}
