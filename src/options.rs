@@ -33,8 +33,11 @@ pub enum OptionType {
 /// A value read or written through [`Params::set_option`] and [`Params::option`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum OptionValue {
+    /// The value of an [`OptionType::Int`] option.
     Int(i64),
+    /// The value of an [`OptionType::Float`] option.
     Float(f64),
+    /// The value of an [`OptionType::Bool`] option.
     Bool(bool),
 }
 

@@ -285,7 +285,7 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    let shape_a = shapecorr::Shape::read(&a, false).unwrap();
+    let shape_a = shapecorr::Shape::read(&a, shapecorr::ReadAs::Auto).unwrap();
     let heat = shapecorr::geodesic::HeatGeodesics::new(&shape_a).unwrap();
     for (target, name) in [(&b, "mesh"), (&cloud, "cloud")] {
         let out_dir = dir.join(format!("p2p-{name}"));

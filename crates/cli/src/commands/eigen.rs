@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use serde_json::json;
 use shapecorr::spectral::laplacian::Laplacian;
+use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Error, Shape};
 
 #[derive(clap::Args)]
@@ -31,7 +32,7 @@ impl EigenArgs {
     pub fn run(&self) -> Result<(), Error> {
         let file = &self.file;
         let t0 = Instant::now();
-        let shape = Shape::read(file, self.points)?;
+        let shape = Shape::read(file, ReadAs::point_cloud_when(self.points))?;
         let t_read = t0.elapsed().as_secs_f64();
         let params = EigenParams {
             n_eigenpairs: self.k,

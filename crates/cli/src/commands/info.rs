@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::spectral::laplacian::Laplacian;
+use shapecorr::ReadAs;
 use shapecorr::{Error, Shape, ShapeKind};
 
 #[derive(clap::Args)]
@@ -20,7 +21,7 @@ pub struct InfoArgs {
 impl InfoArgs {
     pub fn run(&self) -> Result<(), Error> {
         let file = &self.file;
-        let shape = Shape::read(file, self.points)?;
+        let shape = Shape::read(file, ReadAs::point_cloud_when(self.points))?;
         let laplacian = Laplacian::new(&shape)?;
         let warnings: Vec<String> = shape.warnings().iter().map(|w| w.to_string()).collect();
         let kind = match shape.kind() {

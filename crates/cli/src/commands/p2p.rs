@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::maps::pointwise::PointwiseCorrespondence;
+use shapecorr::ReadAs;
 use shapecorr::{Error, Shape};
 
 use crate::options::PointwiseOptions;
@@ -28,8 +29,8 @@ pub struct P2pArgs {
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let shape_a = Shape::read(&self.a, self.points)?;
-        let shape_b = Shape::read(&self.b, self.points)?;
+        let shape_a = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
+        let shape_b = Shape::read(&self.b, ReadAs::point_cloud_when(self.points))?;
         let out = &self.out;
         create_dir(out)?;
         let result = PointwiseCorrespondence::compute(

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::correspondence::{Correspondence, Symmetry};
+use shapecorr::ReadAs;
 use shapecorr::{Error, Shape};
 
 use crate::options::RegionOptions;
@@ -30,8 +31,8 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape_a = Shape::read(&self.a, self.points)?;
-        let shape_b = Shape::read(&self.b, self.points)?;
+        let shape_a = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
+        let shape_b = Shape::read(&self.b, ReadAs::point_cloud_when(self.points))?;
         let out = &self.out;
         create_dir(out)?;
         let result =
@@ -71,7 +72,7 @@ pub struct SymmetryArgs {
 impl SymmetryArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape = Shape::read(&self.a, self.points)?;
+        let shape = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
         let out = &self.out;
         create_dir(out)?;
         let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress);
