@@ -620,6 +620,16 @@ fn table1_rows(r: &DatasetResults) -> Vec<(String, Vec<usize>)> {
 
 fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
     let mut s = String::new();
+    page_header(&mut s, p, all, wall);
+    page_region_accuracy(&mut s, all);
+    page_point_to_point(&mut s, p, all);
+    page_point_clouds(&mut s, p, all);
+    page_timing(&mut s, all);
+    s
+}
+
+/// The page's title and the run: command, version, machine, this invocation, data, paper.
+fn page_header(s: &mut String, p: &AllParams, all: &[DatasetResults], wall: f64) {
     let _ = writeln!(s, "# Results\n");
     let _ = writeln!(
         s,
@@ -661,8 +671,10 @@ fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
         s,
         "- paper: Kleiman and Ovsjanikov, *Robust Structure-based Shape Correspondence*; its figures are on the full benchmarks, ours on the pair lists above (see `../shared/data/README.md`).\n"
     );
+}
 
-    // Table 1.
+/// Region accuracy (paper Table 1) and the paper's segment counts.
+fn page_region_accuracy(s: &mut String, all: &[DatasetResults]) {
     let _ = writeln!(s, "## Region accuracy (paper Table 1)\n");
     let _ = writeln!(
         s,
@@ -716,8 +728,10 @@ fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
             segs.join(", ")
         );
     }
+}
 
-    // Table 2.
+/// Point-to-point maps (paper Table 2) and the error curves.
+fn page_point_to_point(s: &mut String, p: &AllParams, all: &[DatasetResults]) {
     let _ = writeln!(s, "\n## Point-to-point maps (paper Table 2)\n");
     let _ = writeln!(
         s,
@@ -777,8 +791,10 @@ fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
             );
         }
     }
+}
 
-    // Point clouds.
+/// Point clouds (paper section 6.3), one section per dataset that has them.
+fn page_point_clouds(s: &mut String, p: &AllParams, all: &[DatasetResults]) {
     for r in all.iter().filter(|r| !r.clouds.is_empty()) {
         let mesh = mesh_accuracy(&r.regions, &r.clouds);
         let pairs: std::collections::BTreeSet<(&str, &str)> = r
@@ -811,8 +827,10 @@ fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
             let _ = writeln!(s, "\n![{} point clouds]({png})", r.name);
         }
     }
+}
 
-    // Timing.
+/// Timing (paper Table 3), when any dataset was timed.
+fn page_timing(s: &mut String, all: &[DatasetResults]) {
     let timed: Vec<&DatasetResults> = all.iter().filter(|r| !r.timing.is_empty()).collect();
     if !timed.is_empty() {
         let _ = writeln!(s, "\n## Timing (paper Table 3)\n");
@@ -910,7 +928,6 @@ fn results_page(p: &AllParams, all: &[DatasetResults], wall: f64) -> String {
             let _ = writeln!(s, "{row}");
         }
     }
-    s
 }
 
 fn git_commit() -> String {

@@ -1,12 +1,20 @@
 //! Measurement of the graph-matching variants on benchmark pairs (moved from the pipeline's
 //! tests: it needs the dataset registry).
 
+use std::collections::HashMap;
 use std::time::Instant;
 
+use shapecorr::evaluation::score as region_scores;
+use shapecorr::geodesic::region_distance_matrix;
+use shapecorr::regions::matching::match_hop_distances;
 use shapecorr::regions::matching::{
     distance_histograms, leading_eigenvector, unary_costs, Affinity, DistanceTerm, MatchingParams,
 };
-use shapecorr::ReadAs;
+use shapecorr::regions::segmentation::{segment_pair, SegmentationParams};
+use shapecorr::regions::symmetry::{one_to_one, SymmetryParams};
+use shapecorr::spectral::descriptors::{hks, HksParams};
+use shapecorr::{EigenParams, Eigenbasis, ReadAs, Shape};
+use shapecorr_eval::datasets::{default_data_root, read_pairs, Dataset};
 
 /// Real-data measurement: benchmark pairs (`SHAPECORR_DATA` or `../shared/data`; the list
 /// `pairs/$MATCHING_DATASET.txt`, default `faust`), segmented by the default pipeline,
@@ -15,16 +23,6 @@ use shapecorr::ReadAs;
 #[test]
 #[ignore = "measurement on benchmark data; run with --ignored --nocapture"]
 fn measure_variants_on_benchmark_pairs() {
-    use shapecorr::evaluation::score as region_scores;
-    use shapecorr::geodesic::region_distance_matrix;
-    use shapecorr::regions::matching::match_hop_distances;
-    use shapecorr::regions::segmentation::{segment_pair, SegmentationParams};
-    use shapecorr::regions::symmetry::{one_to_one, SymmetryParams};
-    use shapecorr::spectral::descriptors::{hks, HksParams};
-    use shapecorr::{EigenParams, Eigenbasis, Shape};
-    use shapecorr_eval::datasets::{default_data_root, read_pairs, Dataset};
-    use std::collections::HashMap;
-
     let root = default_data_root();
     let dataset = std::env::var("MATCHING_DATASET").unwrap_or_else(|_| "faust".into());
     let list = root.join(format!("pairs/{dataset}.txt"));
@@ -41,42 +39,12 @@ fn measure_variants_on_benchmark_pairs() {
     let step = (pairs.len() / wanted.max(1)).max(1);
     let chosen: Vec<_> = pairs.iter().step_by(step).take(wanted).collect();
 
-    let mut variants: Vec<(String, MatchingParams)> = Vec::new();
-    for (gap, order) in [(0.9, 8), (0.95, 10)] {
-        for normalise in [false, true] {
-            for term in [DistanceTerm::Difference, DistanceTerm::Ratio] {
-                variants.push((
-                    format!("gap {gap} order {order} normalise={normalise:5} {term:?}"),
-                    MatchingParams {
-                        gap_ratio: gap,
-                        max_symmetry_order: order,
-                        normalise_histograms: normalise,
-                        distance_term: term,
-                        ..Default::default()
-                    },
-                ));
-            }
-        }
-    }
-    struct Prepared {
-        shape: Shape,
-        mass: Vec<f64>,
-        hks: faer::Mat<f64>,
-    }
+    let variants = variants();
     let mut cache: HashMap<String, std::rc::Rc<Prepared>> = HashMap::new();
     let mut prepare = |name: &str| {
         cache
             .entry(name.to_string())
-            .or_insert_with(|| {
-                let shape = Shape::read(&dataset.shape_path(name).unwrap(), ReadAs::Auto).unwrap();
-                let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
-                let hks = hks(&basis, &HksParams::default()).unwrap();
-                std::rc::Rc::new(Prepared {
-                    mass: basis.mass.clone(),
-                    shape,
-                    hks,
-                })
-            })
+            .or_insert_with(|| std::rc::Rc::new(prepare_shape(&dataset, name)))
             .clone()
     };
     // Per variant, per category: sums of symmetric accuracy, one-to-one (flip) accuracy,
@@ -122,26 +90,7 @@ fn measure_variants_on_benchmark_pairs() {
             )
             .unwrap();
         let (ha, hb) = (ga.hop_distances(), gb.hop_distances());
-        // The eigensolver on real graphs: converged, and equal to a dense decomposition.
-        for term in [DistanceTerm::Difference, DistanceTerm::Ratio] {
-            let costs = unary_costs(
-                &distance_histograms(&ha, 20, false),
-                &distance_histograms(&hb, 20, false),
-            );
-            let op = Affinity::new(&ha, &hb, &costs, 0.5, term).unwrap();
-            let eig = leading_eigenvector(&op).unwrap();
-            assert!(eig.converged, "{eig:?}");
-            products.push(eig.products);
-            if op.dim() <= 1024 {
-                let n = op.dim();
-                let dense = faer::Mat::from_fn(n, n, |p, q| op.entry(p, q));
-                let evd = dense.self_adjoint_eigen(faer::Side::Lower).unwrap();
-                let diff = (0..n)
-                    .map(|p| (evd.U()[(p, n - 1)].abs() - eig.vector[p]).abs())
-                    .fold(0.0, f64::max);
-                max_dense_difference = max_dense_difference.max(diff);
-            }
-        }
+        check_eigensolver(&ha, &hb, &mut products, &mut max_dense_difference);
         let mut line = format!(
             "{} -> {} ({}, k {}, {na}/{nb} regions):",
             pair.source, pair.target, pair.category, seg.k
@@ -181,6 +130,84 @@ fn measure_variants_on_benchmark_pairs() {
         }
         println!("{line}");
     }
+    print_accuracy(&variants, &sums);
+    print_solver_costs(products, eigen_ms, max_dense_difference);
+}
+
+/// The matching variants measured: symmetry gap and order, histogram normalisation and
+/// distance term.
+fn variants() -> Vec<(String, MatchingParams)> {
+    let mut variants: Vec<(String, MatchingParams)> = Vec::new();
+    for (gap, order) in [(0.9, 8), (0.95, 10)] {
+        for normalise in [false, true] {
+            for term in [DistanceTerm::Difference, DistanceTerm::Ratio] {
+                variants.push((
+                    format!("gap {gap} order {order} normalise={normalise:5} {term:?}"),
+                    MatchingParams {
+                        gap_ratio: gap,
+                        max_symmetry_order: order,
+                        normalise_histograms: normalise,
+                        distance_term: term,
+                        ..Default::default()
+                    },
+                ));
+            }
+        }
+    }
+    variants
+}
+
+/// A shape with what the segmentation needs: its mass matrix and HKS.
+struct Prepared {
+    shape: Shape,
+    mass: Vec<f64>,
+    hks: faer::Mat<f64>,
+}
+
+fn prepare_shape(dataset: &Dataset, name: &str) -> Prepared {
+    let shape = Shape::read(&dataset.shape_path(name).unwrap(), ReadAs::Auto).unwrap();
+    let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
+    let hks = hks(&basis, &HksParams::default()).unwrap();
+    Prepared {
+        mass: basis.mass.clone(),
+        shape,
+        hks,
+    }
+}
+
+/// The eigensolver on real graphs: converged, and equal to a dense decomposition.
+fn check_eigensolver(
+    ha: &[Vec<u32>],
+    hb: &[Vec<u32>],
+    products: &mut Vec<usize>,
+    max_dense_difference: &mut f64,
+) {
+    for term in [DistanceTerm::Difference, DistanceTerm::Ratio] {
+        let costs = unary_costs(
+            &distance_histograms(ha, 20, false),
+            &distance_histograms(hb, 20, false),
+        );
+        let op = Affinity::new(ha, hb, &costs, 0.5, term).unwrap();
+        let eig = leading_eigenvector(&op).unwrap();
+        assert!(eig.converged, "{eig:?}");
+        products.push(eig.products);
+        if op.dim() <= 1024 {
+            let n = op.dim();
+            let dense = faer::Mat::from_fn(n, n, |p, q| op.entry(p, q));
+            let evd = dense.self_adjoint_eigen(faer::Side::Lower).unwrap();
+            let diff = (0..n)
+                .map(|p| (evd.U()[(p, n - 1)].abs() - eig.vector[p]).abs())
+                .fold(0.0, f64::max);
+            *max_dense_difference = max_dense_difference.max(diff);
+        }
+    }
+}
+
+/// Per category, each variant's mean accuracies over the pairs.
+fn print_accuracy(
+    variants: &[(String, MatchingParams)],
+    sums: &HashMap<(usize, String), [f64; 4]>,
+) {
     let mut cats: Vec<String> = sums.keys().map(|k| k.1.clone()).collect();
     cats.sort();
     cats.dedup();
@@ -197,6 +224,10 @@ fn measure_variants_on_benchmark_pairs() {
             );
         }
     }
+}
+
+/// Eigensolver products and matching time over all pairs and variants.
+fn print_solver_costs(mut products: Vec<usize>, mut eigen_ms: Vec<f64>, max_dense_difference: f64) {
     products.sort_unstable();
     println!(
         "eigensolver: products median {} max {}; largest difference to a dense \
