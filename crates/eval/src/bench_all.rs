@@ -681,7 +681,7 @@ fn page_region_accuracy(s: &mut String, all: &[DatasetResults]) {
         "Symmetric matching accuracy: the area-weighted fraction of ground-truth vertex pairs whose \
          regions are matched (paper section 6.2). One-to-one accuracy allows a global left/right flip \
          where a mirror map exists. Reeb: a Reeb graph of one HKS (t = 0.1) matched by the same \
-         graph matcher (`src/reeb.rs`). Each shape's eigenbasis is computed once with 100 \
+         graph matcher (`crates/eval/src/reeb.rs`). Each shape's eigenbasis is computed once with 100 \
          eigenpairs (the pointwise maps need them) and cut to the first 50 for the regions; seconds \
          per pair count both eigenbases as if computed for the pair.\n"
     );

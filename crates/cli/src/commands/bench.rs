@@ -55,7 +55,7 @@ pub struct BenchRegionsArgs {
     #[arg(long)]
     data: Option<PathBuf>,
     /// Pair list DATA/pairs/NAME.txt of the dataset in DATA/NAME (its layout from the
-    /// name or the folder's contents: see src/datasets.rs).
+    /// name or the folder's contents: see crates/eval/src/datasets.rs).
     #[arg(long)]
     pairs: PathBuf,
     /// Only the first N pairs.
@@ -113,7 +113,7 @@ pub struct BenchP2pArgs {
     #[arg(long)]
     data: Option<PathBuf>,
     /// Pair list DATA/pairs/NAME.txt of the dataset in DATA/NAME (its layout from the
-    /// name or the folder's contents: see src/datasets.rs).
+    /// name or the folder's contents: see crates/eval/src/datasets.rs).
     #[arg(long)]
     pairs: PathBuf,
     /// Only the first N pairs.
