@@ -26,7 +26,7 @@ use crate::Result;
 /// and the add-ons all take their defaults from here.
 #[derive(Debug, Clone)]
 pub struct Params {
-    /// Laplacian eigenbasis (100 eigenpairs).
+    /// Laplacian eigenbasis ([`REGION_EIGENPAIRS`] = 50 eigenpairs).
     pub eigen: EigenParams,
     /// Heat kernel signature (15 times in [0.03, 0.25], raw).
     pub hks: HksParams,

@@ -4,7 +4,7 @@
 //! No algorithm lives here: every function checks its arguments, calls the Rust API
 //! ([`crate::Shape`], [`crate::correspondence::Correspondence`], [`crate::options`]) and
 //! turns the result into a status code. The rules, after rustls-ffi:
-//! - every exported body runs inside one panic boundary ([`boundary`]); a panic becomes
+//! - every exported body runs inside one panic boundary (`boundary.rs`); a panic becomes
 //!   `SC_STATUS_PANIC`, never an abort or an unwind into C;
 //! - NULL arguments give `SC_STATUS_NULL_ARGUMENT`; `_free(NULL)` is a no-op;
 //! - out-parameters come last and are written only on success;

@@ -446,7 +446,7 @@ impl RowSystems {
 /// For every row of `query` (`m x k`), the index of the nearest row of `target` (`n x k`)
 /// in Euclidean distance (the lowest index among exact ties). Blocked dense search:
 /// `|q - t|^2 = |t|^2 - 2 q.t + |q|^2`, the middle term by matrix products in single
-/// precision (three times the speed of double here), then the best [`RERANK`] candidates
+/// precision (three times the speed of double here), then the best `RERANK` = 4 candidates
 /// re-ranked by their exact distance. Deterministic on any thread count.
 pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32> {
     assert_eq!(

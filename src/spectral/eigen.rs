@@ -3,8 +3,8 @@
 //!
 //! Method: shift-invert. `A = L + sigma M` (sigma > 0, so A is positive definite even for
 //! several connected pieces) is factored once by faer's supernodal sparse Cholesky; the
-//! largest eigenvalues `theta = 1 / (lambda + sigma)` of the symmetric operator
-//! `M^{1/2} A^{-1} M^{1/2}` are found by a **block Lanczos** iteration with full block
+//! largest eigenvalues `theta = 1 / (lambda + sigma)` of the operator `A^{-1} M`,
+//! self-adjoint in the M inner product, are found by a **block Lanczos** iteration with full block
 //! reorthogonalisation (classical Gram-Schmidt applied twice), then Rayleigh-Ritz on the
 //! block tridiagonal projection. Blocks turn the triangular solves and the
 //! reorthogonalisation into matrix-matrix work (BLAS-3), which is where the time goes; the

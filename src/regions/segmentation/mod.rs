@@ -1,8 +1,9 @@
 //! Joint segmentation of two shapes and their shape graphs (paper, section 4; docs/design.md,
 //! steps 6-9).
 //!
-//! 1. [`rank_align`]: every descriptor column of shape B is mapped onto the values of shape A
-//!    at the same area-weighted rank (paper step 1).
+//! 1. [`rank_align_common`]: every descriptor column of both shapes is mapped onto one
+//!    common distribution, the average of their area-weighted quantile functions (the
+//!    paper's step 1 maps B onto A: [`rank_align`]).
 //! 2. [`joint_kmeans`]: k-means on the stacked descriptors of both shapes, weighted by vertex
 //!    area so that sampling density does not matter (paper step 2). Euclidean by default,
 //!    city block (the authors') as an option: [`DEFAULT_METRIC`] says what was measured.
