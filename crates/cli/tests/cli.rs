@@ -1,6 +1,6 @@
 //! The command-line tool end to end: real processes, real files.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn shapecorr(args: &[&str]) -> std::process::Output {
@@ -14,6 +14,26 @@ fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("shapecorr-cli-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// Writes a generated figure (`shapecorr synth`) to `path` and checks that it worked.
+fn synth_figure(kind: &str, pose: &str, vertices: &str, path: &Path) {
+    let out = shapecorr(&[
+        "synth",
+        "--kind",
+        kind,
+        "--pose",
+        pose,
+        "--vertices",
+        vertices,
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -153,18 +173,7 @@ fn match_and_symmetry_write_their_results() {
     let a = dir.join("a.ply");
     let b = dir.join("b.ply");
     for (path, pose) in [(&a, "0"), (&b, "4")] {
-        let out = shapecorr(&[
-            "synth",
-            "--kind",
-            "humanoid",
-            "--pose",
-            pose,
-            "--vertices",
-            "3000",
-            "--out",
-            path.to_str().unwrap(),
-        ]);
-        assert!(out.status.success());
+        synth_figure("humanoid", pose, "3000", path);
     }
     let out_dir = dir.join("result");
     let out = shapecorr(&[
@@ -435,18 +444,7 @@ fn set_and_the_flag_set_the_same_option() {
     let a = dir.join("a.ply");
     let b = dir.join("b.ply");
     for (path, pose) in [(&a, "0"), (&b, "2")] {
-        let out = shapecorr(&[
-            "synth",
-            "--kind",
-            "star4",
-            "--pose",
-            pose,
-            "--vertices",
-            "1500",
-            "--out",
-            path.to_str().unwrap(),
-        ]);
-        assert!(out.status.success());
+        synth_figure("star4", pose, "1500", path);
     }
     let run = |name: &str, extra: &[&str]| -> serde_json::Value {
         let out_dir = dir.join(name);
