@@ -12,6 +12,7 @@ use std::time::Instant;
 
 use crate::colors::{palette, region_colors, UNMATCHED_COLOR};
 use crate::geodesic::region_distance_matrix;
+use crate::maps::hypotheses::Verdict;
 use crate::progress::{check, NoProgress, Progress, Stage};
 use crate::regions::graph::ShapeGraph;
 use crate::regions::matching::{match_graphs, MatchingParams};
@@ -47,6 +48,11 @@ pub struct Params {
     /// 0.801 -> 0.923); two pairs change. A smaller t_min for every pair instead hurt remeshed
     /// TOSCA (0.940, one pair 0.013). `None` turns it off.
     pub fallback: Option<HksFallback>,
+    /// Choose the one-to-one matches among hypotheses (the answer, its mirror image, the
+    /// symmetric groups, single-group alternatives) by their maps refined on the regions'
+    /// eigenbasis ([`crate::maps::hypotheses`]), and give the answer a confidence. Measured
+    /// in docs/decisions.md (issue 18).
+    pub verify_hypotheses: bool,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -70,6 +76,7 @@ impl Default for Params {
             symmetry: SymmetryParams::default(),
             skip_one_to_one: false,
             fallback: Some(HksFallback::default()),
+            verify_hypotheses: true,
             non_exhaustive: crate::NonExhaustive(()),
         }
     }
@@ -118,7 +125,7 @@ pub struct Timings {
     pub segmentation: f64,
     /// Spectral graph matching, the fallback try included.
     pub matching: f64,
-    /// Symmetry breaking into the one-to-one matches.
+    /// Symmetry breaking into the one-to-one matches, their verification included.
     pub one_to_one: f64,
     /// Whole call, from [`Correspondence::compute`] or [`Correspondence::from_bases`].
     pub total: f64,
@@ -141,6 +148,9 @@ pub struct Correspondence {
     pub candidates: Vec<KCandidate>,
     /// Seconds per stage.
     pub timings: Timings,
+    /// The one-to-one hypotheses verified at the map level and the confidence of the
+    /// answer ([`Params::verify_hypotheses`]; None when off or when there was no choice).
+    pub verdict: Option<Verdict>,
 }
 
 impl Correspondence {
@@ -227,11 +237,7 @@ impl Correspondence {
             &matching.matches,
             params,
         )?;
-        timings.one_to_one = t.elapsed().as_secs_f64();
-        check(progress, Stage::SymmetryBreaking, 1.0)?;
-        timings.total = started.elapsed().as_secs_f64();
-
-        Ok(Correspondence {
+        let mut result = Correspondence {
             k: segmentation.k,
             graph_a: segmentation.graph_a,
             graph_b: segmentation.graph_b,
@@ -239,7 +245,20 @@ impl Correspondence {
             matches_one_to_one,
             candidates: segmentation.candidates,
             timings,
-        })
+            verdict: None,
+        };
+        if params.verify_hypotheses && !params.skip_one_to_one {
+            crate::maps::pointwise::verify_regions((a, basis_a), (b, basis_b), &mut result)?;
+        }
+        result.timings.one_to_one = t.elapsed().as_secs_f64();
+        check(progress, Stage::SymmetryBreaking, 1.0)?;
+        result.timings.total = started.elapsed().as_secs_f64();
+        Ok(result)
+    }
+
+    /// The confidence of the one-to-one answer in [0, 1] (None when it was not verified).
+    pub fn confidence(&self) -> Option<f64> {
+        self.verdict.as_ref().map(|v| v.confidence)
     }
 
     /// Region of every vertex of A.

@@ -275,7 +275,17 @@ pub const OPTIONS: &[OptionInfo] = &[
     p2p(
         "p2p_orientation",
         Bool,
-        "pointwise map: choose between the answer and its mirror image by orientation (meshes)",
+        "pointwise map: verify the answer's mirror image as a hypothesis (orientable meshes)",
+    ),
+    p2p(
+        "p2p_hypotheses",
+        Bool,
+        "pointwise map: verify the symmetric groups and single-group alternatives as hypotheses",
+    ),
+    info(
+        "verify_hypotheses",
+        Bool,
+        "regions: choose among one-to-one hypotheses by their refined maps (and give a confidence)",
     ),
 ];
 
@@ -454,6 +464,7 @@ impl Params {
                 "hks_fallback" => {
                     self.fallback = v.then(|| self.fallback.clone().unwrap_or_default())
                 }
+                "verify_hypotheses" => self.verify_hypotheses = v,
                 other => unreachable!("bool option {other} has no field"),
             },
         }
@@ -486,6 +497,7 @@ impl Params {
             "exhaustive_limit" => int(self.symmetry.exhaustive_limit),
             "symmetry_restarts" => int(self.symmetry.restarts),
             "hks_fallback" => OptionValue::Bool(self.fallback.is_some()),
+            "verify_hypotheses" => OptionValue::Bool(self.verify_hypotheses),
             other => unreachable!("option {other} has no field"),
         })
     }
@@ -617,6 +629,7 @@ impl Options {
                 "p2p_region_distances" => p.region_distances = v,
                 "p2p_wks" => p.wks = v.then(|| p.wks.clone().unwrap_or_default()),
                 "p2p_orientation" => p.orientation = v,
+                "p2p_hypotheses" => p.hypotheses = v,
                 other => unreachable!("bool option {other} has no field"),
             },
         }
@@ -654,6 +667,7 @@ impl Options {
             "p2p_zoomout_sample" => int(self.zoomout.sample_size),
             "p2p_icp_iterations" => int(self.icp_iterations),
             "p2p_orientation" => OptionValue::Bool(p.orientation),
+            "p2p_hypotheses" => OptionValue::Bool(p.hypotheses),
             other => unreachable!("option {other} has no field"),
         })
     }
@@ -924,7 +938,8 @@ mod tests {
     #[test]
     fn orientation_is_the_pointwise_params_switch() {
         let last = OPTIONS.last().unwrap();
-        assert_eq!((last.name, last.option_type), ("p2p_orientation", Bool));
+        assert_eq!((last.name, last.option_type), ("verify_hypotheses", Bool));
+        assert!(Options::default().pointwise().hypotheses);
         let mut options = Options::default();
         assert_eq!(
             options.option("p2p_orientation").unwrap(),

@@ -1,5 +1,7 @@
 //! Point-to-point maps from the region correspondence (paper, section 6.4): functional
-//! maps and their refinement ([`fmap`]), and the whole pointwise job ([`pointwise`]).
+//! maps and their refinement ([`fmap`]), the region hypotheses verified at the map level
+//! ([`hypotheses`]), and the whole pointwise job ([`pointwise`]).
 
 pub mod fmap;
+pub mod hypotheses;
 pub mod pointwise;

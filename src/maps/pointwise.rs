@@ -14,9 +14,10 @@ use rayon::prelude::*;
 use crate::correspondence::{Correspondence, Params};
 use crate::maps::fmap::{
     fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, project,
-    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, SampledZoomOut,
-    ZoomOutParams,
+    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
 };
+pub use crate::maps::hypotheses::orientation_score;
+use crate::maps::hypotheses::{self, HypothesisKind, RegionGroups, Verdict};
 use crate::progress::{check, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
@@ -80,12 +81,14 @@ pub struct PointwiseParams {
     pub orientation_term: f64,
     /// Refinement of the first map.
     pub refinement: Refinement,
-    /// For orientable meshes, choose between the one-to-one region answer and its mirror
-    /// image (another choice in every symmetric group): both are solved (with the
-    /// orientation term) and refined by ZoomOut on the samples, and the map with the larger
-    /// product of A's samples reached and B's sample triangles keeping their orientation
-    /// wins; only the winner is converted at full resolution.
+    /// On orientable meshes, also verify the mirror image of the one-to-one region answer
+    /// (another choice in every symmetric group) as a hypothesis.
     pub orientation: bool,
+    /// Verify more region hypotheses than the answer (and its mirror image): the symmetric
+    /// groups and the best single-group alternatives ([`hypotheses::candidates`]). Every
+    /// hypothesis is solved and refined by ZoomOut on the samples; the map of lowest
+    /// [`hypotheses::MapEnergy::cost`] wins, and only it is converted at full resolution.
+    pub hypotheses: bool,
 }
 
 impl Default for PointwiseParams {
@@ -104,6 +107,7 @@ impl Default for PointwiseParams {
             orientation_term: 0.003,
             refinement: Refinement::ZoomOut(ZoomOutParams::default()),
             orientation: true,
+            hypotheses: true,
         }
     }
 }
@@ -192,6 +196,9 @@ pub struct PointwiseMap {
     pub p2p_ba: Vec<u32>,
     /// The final functional map from A to B (`k x k`).
     pub fmap_ab: Mat<f64>,
+    /// The region hypotheses verified at the map level, the chosen one and its confidence
+    /// (None when there was one hypothesis only).
+    pub verdict: Option<Verdict>,
     /// Seconds of the first functional map and of its refinement.
     pub timings: PointwiseTimings,
 }
@@ -221,15 +228,28 @@ impl PointwiseMap {
         } else {
             None
         };
-        let mirror = match (regions, params.regions, &faces) {
-            (Some(regions), RegionConstraints::OneToOne, Some(_)) if params.orientation => {
-                Some(mirrored_groups(a, basis_a, b, basis_b, regions)).filter(|m| *m != groups)
+        let kinds_and_groups: Vec<(HypothesisKind, RegionGroups)> = match regions {
+            Some(regions) if params.regions == RegionConstraints::OneToOne => {
+                let with_mirror = params.orientation && faces.is_some();
+                if params.hypotheses {
+                    hypotheses::candidates((a, basis_a), (b, basis_b), regions, with_mirror)
+                } else if with_mirror {
+                    hypotheses::candidates((a, basis_a), (b, basis_b), regions, true)
+                        .into_iter()
+                        .filter(|(kind, _)| {
+                            matches!(kind, HypothesisKind::Answer | HypothesisKind::Mirror)
+                        })
+                        .collect()
+                } else {
+                    vec![(HypothesisKind::Answer, groups)]
+                }
             }
-            _ => None,
+            _ => vec![(HypothesisKind::Answer, groups)],
         };
-        let candidates: Vec<&[(Vec<u32>, Vec<u32>)]> = std::iter::once(groups.as_slice())
-            .chain(mirror.as_deref())
-            .collect();
+        let (kinds, candidates): (Vec<HypothesisKind>, Vec<RegionGroups>) =
+            kinds_and_groups.into_iter().unzip();
+        let candidate_refs: Vec<&[(Vec<u32>, Vec<u32>)]> =
+            candidates.iter().map(Vec::as_slice).collect();
         let orientation_faces = faces
             .as_ref()
             .filter(|_| params.orientation_term > 0.0)
@@ -238,26 +258,49 @@ impl PointwiseMap {
             (a, basis_a),
             (b, basis_b),
             regions,
-            &candidates,
+            &candidate_refs,
             orientation_faces,
             params,
             k,
         )?;
         let fmaps = (0..candidates.len())
+            .into_par_iter()
             .map(|c| features.solve(c, basis_a, basis_b, params))
             .collect::<Result<Vec<_>>>()?;
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let (fmap_ab, p2p_ba) = match &faces {
-            Some(faces) if fmaps.len() > 1 => {
-                let bases = (basis_a, basis_b);
-                orientation_winner((a, b), bases, faces, &fmaps, params, k)?
-            }
-            _ => refine(&fmaps[0], (basis_a, basis_b), params, k)?,
+        let (fmap_ab, p2p_ba, verdict) = if fmaps.len() > 1 {
+            let verdict = verified(
+                (a, basis_a),
+                (b, basis_b),
+                faces.as_ref(),
+                kinds,
+                &fmaps,
+                params,
+                k,
+            )?;
+            let (fmap_ab, p2p_ba) = match &params.refinement {
+                // The chosen map is already refined on the samples.
+                Refinement::ZoomOut(_) => {
+                    let fmap = verdict.scores[verdict.chosen].fmap_ab.clone();
+                    let p2p = fmap_to_p2p(
+                        fmap.as_ref(),
+                        basis_a.vectors.as_ref(),
+                        basis_b.vectors.as_ref(),
+                    );
+                    (fmap, p2p)
+                }
+                _ => refine(&fmaps[verdict.chosen], (basis_a, basis_b), params, k)?,
+            };
+            (fmap_ab, p2p_ba, Some(verdict))
+        } else {
+            let (fmap_ab, p2p_ba) = refine(&fmaps[0], (basis_a, basis_b), params, k)?;
+            (fmap_ab, p2p_ba, None)
         };
         Ok(PointwiseMap {
             p2p_ba,
             fmap_ab,
+            verdict,
             timings: PointwiseTimings {
                 fmap: t_fmap,
                 refinement: t.elapsed().as_secs_f64(),
@@ -331,30 +374,25 @@ fn refine(
     }
 }
 
-/// The candidate functional maps `fmaps` (the answer and its mirror image) decided by
-/// orientation on consistently oriented meshes (`faces` of A and B), refined: the final map
-/// and its vertex map.
-fn orientation_winner(
-    (a, b): (&Shape, &Shape),
-    (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
-    (faces_a, faces_b): &(Vec<[u32; 3]>, Vec<[u32; 3]>),
+/// The hypotheses' functional maps `fmaps` refined by ZoomOut on the same samples and
+/// judged by [`hypotheses::energies`]: the verdict.
+fn verified(
+    (a, basis_a): (&Shape, &Eigenbasis),
+    (b, basis_b): (&Shape, &Eigenbasis),
+    faces: Option<&(Vec<[u32; 3]>, Vec<[u32; 3]>)>,
+    kinds: Vec<HypothesisKind>,
     fmaps: &[Mat<f64>],
     params: &PointwiseParams,
     k: usize,
-) -> Result<(Mat<f64>, Vec<u32>)> {
+) -> Result<Verdict> {
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
-    // The answer and its mirror image, each refined by ZoomOut on the samples.
-    // The orientation term makes the candidate whose regions agree with the
-    // orientation a consistent map, and the other a compromise that folds part
-    // of the shape onto itself or turns it over: it reaches fewer of A's
-    // samples, or keeps the orientation of fewer triangles. Only the winner is
-    // converted at full resolution.
     let decision = match &params.refinement {
         Refinement::ZoomOut(z) => z.clone(),
         _ => ZoomOutParams::default(),
     };
-    let mut sampled = fmaps
-        .iter()
+    let decision = clamped(&decision, (basis_a, basis_b), k);
+    let sampled = fmaps
+        .par_iter()
         .map(|fmap| {
             zoomout_on_samples(
                 fmap.as_ref(),
@@ -362,74 +400,21 @@ fn orientation_winner(
                 &basis_a.mass,
                 phi_b,
                 &basis_b.mass,
-                &clamped(&decision, (basis_a, basis_b), k),
+                &decision,
             )
         })
         .collect::<Result<Vec<_>>>()?;
-    // Every candidate ran on the same samples (fixed seeds).
-    let triangles_b = sample_triangles(
-        b.vertices(),
-        &vertex_normals(b.vertices(), faces_b),
-        &sampled[0].sample_b.vertices,
-    );
-    let normals_a = vertex_normals(a.vertices(), faces_a);
-    let score: Vec<f64> = sampled
-        .iter()
-        .map(|s| sample_consistency((a.vertices(), &normals_a), &triangles_b, s))
-        .collect();
-    let mut best = argmax(&score);
-    let runner_up = (0..score.len())
-        .filter(|&c| c != best)
-        .map(|c| score[c])
-        .fold(0.0, f64::max);
-    // A close call is decided at full resolution: every candidate converted,
-    // A's vertices reached times B's triangles keeping their orientation.
-    let mut full: Vec<Option<Vec<u32>>> = vec![None; sampled.len()];
-    if score[best] < CLOSE_CALL * runner_up {
-        let full_score: Vec<f64> = sampled
-            .iter()
-            .zip(&mut full)
-            .map(|(s, slot)| {
-                let p2p = fmap_to_p2p(s.fmap_ab.as_ref(), phi_a, phi_b);
-                let covered = covered_vertices(&p2p, a.n_vertices()) as f64;
-                let kept = orientation_kept((a.vertices(), &normals_a), faces_b, &p2p);
-                *slot = Some(p2p);
-                covered * kept.unwrap_or(0.0)
-            })
-            .collect();
-        best = argmax(&full_score);
-    }
-    Ok(match &params.refinement {
-        Refinement::ZoomOut(_) => {
-            let fmap = sampled.swap_remove(best).fmap_ab;
-            let p2p = full
-                .swap_remove(best)
-                .unwrap_or_else(|| fmap_to_p2p(fmap.as_ref(), phi_a, phi_b));
-            (fmap, p2p)
-        }
-        _ => refine(&fmaps[best], (basis_a, basis_b), params, k)?,
-    })
+    let energies = hypotheses::energies((a, basis_a), (b, basis_b), faces, &sampled);
+    let sample_maps: Vec<&[u32]> = sampled.iter().map(|s| s.p2p_ba.as_slice()).collect();
+    let sample_fmaps = sampled.iter().map(|s| s.fmap_ab.clone()).collect();
+    Ok(hypotheses::choose(
+        kinds,
+        energies,
+        sample_fmaps,
+        &sample_maps,
+        (a.vertices(), basis_a.input_area),
+    ))
 }
-
-/// Number of distinct vertices of A that the map reaches.
-fn covered_vertices(p2p_ba: &[u32], n_a: usize) -> usize {
-    let mut hit = vec![false; n_a];
-    for &v in p2p_ba {
-        hit[v as usize] = true;
-    }
-    hit.into_iter().filter(|&h| h).count()
-}
-
-/// The index of the largest score (the first among equals).
-fn argmax(scores: &[f64]) -> usize {
-    (1..scores.len()).fold(0, |best, c| if scores[c] > scores[best] { c } else { best })
-}
-
-/// The mirror decision is a close call when the winner's sample score is below this many
-/// times the runner-up's; it is then made at full resolution. On 74 FAUST and TOSCA pairs
-/// the sample and the full-resolution decisions agreed, the closest sample margin 0.2%
-/// (six TOSCA pairs within 5%, no FAUST pair).
-const CLOSE_CALL: f64 = 1.05;
 
 /// Descriptor columns of one shape, computed once for every region set any candidate uses.
 struct SideFeatures {
@@ -647,214 +632,6 @@ impl Features {
     }
 }
 
-/// Small triangles of B's samples: each sample with its two nearest samples, as positions
-/// in `samples_b`, and whether it turns counter-clockwise about B's vertex normals
-/// (degenerate ones left out).
-fn sample_triangles(
-    vb: &[[f64; 3]],
-    normals_b: &[[f64; 3]],
-    samples_b: &[u32],
-) -> Vec<([usize; 3], bool)> {
-    let points: Vec<[f64; 3]> = samples_b.iter().map(|&v| vb[v as usize]).collect();
-    let tree = crate::shape::neighbors::PointTree::new(&points);
-    let mut triangles = Vec::with_capacity(points.len());
-    for (s, p) in points.iter().enumerate() {
-        let near: Vec<usize> = tree
-            .nearest_k(p, 3)
-            .into_iter()
-            .map(|(j, _)| j)
-            .filter(|&j| j != s)
-            .take(2)
-            .collect();
-        if let [j, l] = near[..] {
-            let corners = [s, j, l];
-            let turn = signed_turn(vb, corners.map(|c| samples_b[c] as usize), normals_b);
-            if turn != 0.0 {
-                triangles.push((corners, turn > 0.0));
-            }
-        }
-    }
-    triangles
-}
-
-/// How consistent a map refined on samples is, without converting it at full resolution:
-/// the fraction of A's sample vertices that B's samples reach, times the fraction of B's
-/// [`sample_triangles`] whose image keeps its orientation (judged by A's vertex normals of
-/// its oriented faces). A map that folds part of the shape onto itself reaches fewer
-/// samples; one that turns part of it over reverses more triangles.
-fn sample_consistency(
-    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
-    triangles_b: &[([usize; 3], bool)],
-    sampled: &SampledZoomOut,
-) -> f64 {
-    let coverage = covered_vertices(&sampled.p2p_ba, va.len()) as f64
-        / sampled.sample_a.vertices.len().max(1) as f64;
-    let (mut kept, mut total) = (0usize, 0usize);
-    for (corners, counter_clockwise) in triangles_b {
-        let images = corners.map(|c| sampled.p2p_ba[c] as usize);
-        let turn = signed_turn(va, images, normals_a);
-        if turn != 0.0 {
-            total += 1;
-            if (turn > 0.0) == *counter_clockwise {
-                kept += 1;
-            }
-        }
-    }
-    coverage * kept as f64 / total.max(1) as f64
-}
-
-/// Fraction of B's triangles whose image under `p2p_ba` keeps its orientation on A
-/// (the mapped triangle's normal agrees with A's vertex normals there), both shapes' faces
-/// taken as [`Shape::oriented_triangles`]; `None` when either shape is a point cloud or
-/// not orientable, or no triangle maps to a proper triangle.
-pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
-    let normals_a = vertex_normals(a.vertices(), &a.oriented_triangles()?);
-    orientation_kept((a.vertices(), &normals_a), &b.oriented_triangles()?, p2p_ba)
-}
-
-/// [`orientation_score`] with A's vertex normals ([`vertex_normals`] of its oriented faces)
-/// and B's oriented faces given.
-fn orientation_kept(
-    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
-    triangles_b: &[[u32; 3]],
-    p2p_ba: &[u32],
-) -> Option<f64> {
-    let (mut kept, mut total) = (0usize, 0usize);
-    for t in triangles_b {
-        let turn = signed_turn(va, t.map(|v| p2p_ba[v as usize] as usize), normals_a);
-        if turn != 0.0 {
-            total += 1;
-            if turn > 0.0 {
-                kept += 1;
-            }
-        }
-    }
-    (total > 0).then(|| kept as f64 / total as f64)
-}
-
-/// Area-weighted vertex normals (not normalised) of oriented faces.
-fn vertex_normals(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<[f64; 3]> {
-    let mut normals = vec![[0.0; 3]; vertices.len()];
-    for t in faces {
-        let [p, q, r] = t.map(|v| vertices[v as usize]);
-        let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
-        for &v in t {
-            for c in 0..3 {
-                normals[v as usize][c] += n[c];
-            }
-        }
-    }
-    normals
-}
-
-/// The triangle of three vertices, seen against their summed vertex normals: positive when it
-/// turns counter-clockwise about them, negative when clockwise, 0 when two corners coincide.
-fn signed_turn(vertices: &[[f64; 3]], c: [usize; 3], normals: &[[f64; 3]]) -> f64 {
-    if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
-        return 0.0;
-    }
-    let [p, q, r] = c.map(|v| vertices[v]);
-    let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
-    let reference: [f64; 3] =
-        std::array::from_fn(|i| normals[c[0]][i] + normals[c[1]][i] + normals[c[2]][i]);
-    crate::shape::dot(&n, &reference)
-}
-
-/// Largest number of alternative matchings (besides the current one) enumerated for one
-/// symmetric group when looking for the mirror-image answer (a 4x4 group of two left/right
-/// pairs has 23); a group with more keeps its current matching.
-const MIRROR_OPTIONS_CAP: usize = 5040;
-
-/// The mirror image of the one-to-one answer: in every symmetric group with a choice, a
-/// different matching of the same size (for a left/right pair: the swap), the groups chosen
-/// together to minimise the distortion of region distances
-/// ([`crate::regions::symmetry::distortion_energy`]) by a few sweeps of coordinate descent. A region
-/// may keep its partner: a centaur's group of two arms and a middle region mirrors by
-/// swapping the arms only (requiring every pair to change, as this did before, left such
-/// groups no true mirror, and the centaurs' maps mirrored). Returned as one-to-one groups;
-/// equal to `groups` when no group has a choice.
-fn mirrored_groups(
-    a: &Shape,
-    basis_a: &Eigenbasis,
-    b: &Shape,
-    basis_b: &Eigenbasis,
-    regions: &Correspondence,
-) -> Vec<(Vec<u32>, Vec<u32>)> {
-    let current = &regions.matches_one_to_one;
-    let mut fixed: Vec<(u32, u32)> = Vec::new();
-    let mut choices: Vec<Vec<Vec<(u32, u32)>>> = Vec::new();
-    for (ra, rb) in crate::regions::symmetry::bipartite_groups(&regions.matches) {
-        let in_group = |p: &(u32, u32)| ra.binary_search(&p.0).is_ok();
-        let mut mine: Vec<(u32, u32)> = current.iter().copied().filter(in_group).collect();
-        mine.sort_unstable();
-        let edges: Vec<(u32, u32)> = regions.matches.iter().copied().filter(in_group).collect();
-        let (options, complete) =
-            crate::regions::symmetry::max_matchings(&ra, &rb, &edges, MIRROR_OPTIONS_CAP + 1);
-        // Each option lists its pairs by ascending A region, as `mine` does.
-        let full: Vec<Vec<(u32, u32)>> = options
-            .into_iter()
-            .filter(|m| m.len() == mine.len() && *m != mine)
-            .collect();
-        if ra.len() + rb.len() <= 2 || full.is_empty() || !complete {
-            fixed.extend(mine);
-        } else {
-            choices.push(full);
-        }
-    }
-    if choices.is_empty() {
-        return current.iter().map(|&(i, j)| (vec![i], vec![j])).collect();
-    }
-    let d_a = crate::geodesic::region_distance_matrix(
-        a,
-        &basis_a.mass,
-        regions.regions_a(),
-        regions.graph_a.n_nodes(),
-        1.0 / basis_a.input_area.sqrt(),
-    );
-    let d_b = crate::geodesic::region_distance_matrix(
-        b,
-        &basis_b.mass,
-        regions.regions_b(),
-        regions.graph_b.n_nodes(),
-        1.0 / basis_b.input_area.sqrt(),
-    );
-    let assemble = |pick: &[usize]| {
-        let mut pairs = fixed.clone();
-        for (g, &o) in pick.iter().enumerate() {
-            pairs.extend(&choices[g][o]);
-        }
-        pairs
-    };
-    let energy = |pick: &[usize]| {
-        crate::regions::symmetry::distortion_energy(&assemble(pick), d_a.as_ref(), d_b.as_ref())
-    };
-    let mut pick = vec![0usize; choices.len()];
-    for _sweep in 0..4 {
-        let mut changed = false;
-        for g in 0..choices.len() {
-            let mut best = (energy(&pick), pick[g]);
-            for o in 0..choices[g].len() {
-                let mut trial = pick.clone();
-                trial[g] = o;
-                let e = energy(&trial);
-                if e < best.0 - 1e-12 {
-                    best = (e, o);
-                }
-            }
-            if best.1 != pick[g] {
-                pick[g] = best.1;
-                changed = true;
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
-    let mut pairs = assemble(&pick);
-    pairs.sort_unstable();
-    pairs.into_iter().map(|(i, j)| (vec![i], vec![j])).collect()
-}
-
 /// Everything from two shapes: eigenbases, region correspondence, pointwise map.
 #[derive(Debug, Clone)]
 pub struct PointwiseCorrespondence {
@@ -868,6 +645,20 @@ pub struct PointwiseCorrespondence {
     pub eigenbasis_b: f64,
     /// Seconds of the whole call.
     pub total: f64,
+}
+
+impl PointwiseCorrespondence {
+    /// The verdict behind the answer: the map's own when it verified hypotheses, else the
+    /// regions'.
+    pub fn verdict(&self) -> Option<&Verdict> {
+        self.map.verdict.as_ref().or(self.regions.verdict.as_ref())
+    }
+
+    /// The confidence of the answer in [0, 1] ([`PointwiseCorrespondence::verdict`]; None
+    /// when nothing was verified).
+    pub fn confidence(&self) -> Option<f64> {
+        self.verdict().map(|v| v.confidence)
+    }
 }
 
 impl PointwiseCorrespondence {
@@ -912,6 +703,39 @@ impl PointwiseCorrespondence {
             total: started.elapsed().as_secs_f64(),
         })
     }
+}
+
+/// Verifies the one-to-one answer of `regions` at the map level on the regions' own
+/// eigenbases (ZoomOut up to their size): the hypotheses of [`hypotheses::candidates`] are
+/// refined and judged, the one-to-one matches become those that agree best with the chosen
+/// map ([`hypotheses::one_to_one_from_map`]) and the verdict is kept with them. Nothing
+/// changes when there is a single hypothesis.
+pub fn verify_regions(
+    (a, basis_a): (&Shape, &Eigenbasis),
+    (b, basis_b): (&Shape, &Eigenbasis),
+    regions: &mut Correspondence,
+) -> Result<()> {
+    if regions.matches_one_to_one.is_empty() {
+        return Ok(());
+    }
+    let n = basis_a.len().min(basis_b.len());
+    let defaults = PointwiseParams::default();
+    let params = PointwiseParams {
+        n_eigenpairs: n,
+        fmap_size: defaults.fmap_size.min(n),
+        refinement: Refinement::ZoomOut(ZoomOutParams {
+            k_end: n,
+            ..Default::default()
+        }),
+        ..defaults
+    };
+    let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(regions), &params)?;
+    if let Some(verdict) = map.verdict {
+        regions.matches_one_to_one =
+            hypotheses::one_to_one_from_map(regions, &map.p2p_ba, &basis_b.mass);
+        regions.verdict = Some(verdict);
+    }
+    Ok(())
 }
 
 /// The first `k` eigenpairs of a basis (a copy; the eigenvectors of a larger solve agree

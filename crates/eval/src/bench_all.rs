@@ -24,7 +24,7 @@ use crate::bench::{region_pair, PairResult};
 use crate::bench_clouds::{cloud_figure, cloud_table, cloud_trials, CloudProtocol, CloudTrial};
 use crate::bench_pointwise::{pointwise_pair, select_methods, write_curves, PairScores};
 use crate::bench_store::{BasisCache, ProgressBar, ResultLog, ShapeStore};
-use crate::datasets::{discover, read_pairs, Dataset, Pair};
+use crate::datasets::{discover, Dataset, Pair};
 use crate::reeb::{reeb_correspondence, ReebParams};
 use shapecorr::correspondence::{Correspondence, Params, Timings};
 use shapecorr::maps::pointwise::{PointwiseCorrespondence, PointwiseParams, PointwiseTimings};
@@ -298,7 +298,7 @@ fn pair_key(r: &PairResult) -> (String, String) {
 
 fn run_dataset(p: &AllParams, dataset: &Dataset) -> Result<DatasetResults> {
     let name = dataset.name.as_str();
-    let pairs = spread(&read_pairs(&dataset.pairs_file(&p.data))?, p.limit);
+    let pairs = spread(&dataset.pairs(&p.data)?, p.limit);
     let logs = p.work.join("logs");
     let eigen = EigenParams {
         n_eigenpairs: p.pointwise.n_eigenpairs.max(p.params.eigen.n_eigenpairs),

@@ -19,7 +19,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::bench_store::{BasisCache, ShapeStore};
-use crate::datasets::{read_pairs, Dataset, Pair};
+use crate::datasets::{pair_list, Pair};
 use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
 use shapecorr::maps::pointwise::{
@@ -145,9 +145,9 @@ pub struct PairScores {
     pub scores: Vec<MapScore>,
 }
 
-/// Scores maps `p2p_ba` of one pair against its ground truth (a seeded sample of at most
+/// Scores maps `p2p_ba` (name, map, seconds) of one pair against its ground truth (a seeded sample of at most
 /// `samples` pairs; 0 = all).
-fn score_maps(
+pub fn score_maps(
     store: &mut ShapeStore,
     pair: &Pair,
     maps: &[(String, Vec<u32>, f64)],
@@ -359,14 +359,6 @@ pub fn bench_map_files(
     Ok(results)
 }
 
-/// The dataset and the (first `limit`) pairs of a pair list.
-fn pair_list(root: &Path, pairs_file: &Path, limit: Option<usize>) -> Result<(Dataset, Vec<Pair>)> {
-    let dataset = Dataset::for_pairs_file(root, pairs_file)?;
-    let mut pairs = read_pairs(pairs_file)?;
-    pairs.truncate(limit.unwrap_or(usize::MAX));
-    Ok((dataset, pairs))
-}
-
 /// Reads a map file: one 0-based vertex index per line.
 pub fn read_map(path: &Path) -> Result<Vec<u32>> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e.to_string()))?;
@@ -432,6 +424,32 @@ pub fn pointwise_table(results: &[PairScores]) -> String {
         }
     }
     out
+}
+
+/// Per method: the mean, median and worst pair of the mean error (flip allowed where a
+/// mirror map exists) and the count of failed pairs ([`crate::tails::FAILED_ERRORS`]).
+pub fn pointwise_tails_table(results: &[PairScores]) -> String {
+    let methods: Vec<String> = results
+        .first()
+        .map(|r| r.scores.iter().map(|s| s.method.clone()).collect())
+        .unwrap_or_default();
+    let rows: Vec<(String, Vec<(f64, String)>)> = methods
+        .iter()
+        .enumerate()
+        .map(|(m, method)| {
+            let values = results
+                .iter()
+                .map(|r| {
+                    (
+                        r.scores[m].best_mean(),
+                        format!("{} -> {}", r.source, r.target),
+                    )
+                })
+                .collect();
+            (method.clone(), values)
+        })
+        .collect();
+    crate::tails::error_tails_table(&rows)
 }
 
 /// Cumulative error curves over all pairs (flip allowed where a mirror map exists): one

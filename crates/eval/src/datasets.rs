@@ -13,6 +13,12 @@
 //! | [`Layout::SharedOrderPerClass`] (TOSCA `cat0`, `david13`) | `NAME/X.{ply,off,obj}` | identity within a class (name without trailing digits) | `NAME/CLASS_mirror.txt` |
 //! | [`Layout::Vts`] (FAUST_r, SCAPE_r, TOSCA_r) | `NAME/off/X.off` or `NAME/shapes/X.*` | `NAME/corres/X.vts`: row k of A's file matches row k of B's (1-based) | `NAME/corres/X.sym.vts` |
 //! | [`Layout::TemplateIndex`] (remeshed shapes) | `NAME/shapes/X.*` | `NAME/template/X.txt`: the 0-based template vertex of every vertex | `NAME/template_mirror.txt` on the template |
+//! | [`Layout::VertexMaps`] (camel gallop, lion/cat) | `FOLDER/X.off` | a map file per pair: the 0-based target vertex of every source vertex (vertex 0 as a placeholder left out, [`zero_placeholder`]) | none (meshes: orientation is known) |
+//!
+//! The vertex-map datasets come without a pair list; their pairs are their map files
+//! ([`VERTEX_MAP_DATASETS`]): `camel_gallop` is `nonisometric/camel_gallop` with
+//! `maps/i_to_j` for frames `camel-gallop-0i` -> `camel-gallop-0j` (30 pairs), `lion_cat` is
+//! `nonisometric` with `lion2cat` for `lion-00` -> `cat-00`.
 //!
 //! Mirror maps give, per vertex (of the template), the vertex at the mirrored position. Every
 //! missing or malformed file is an [`Error::File`] naming the path and what was expected.
@@ -73,7 +79,15 @@ pub enum Layout {
     Vts,
     /// Independently remeshed shapes with a per-vertex template index.
     TemplateIndex,
+    /// A vertex map file per pair (the pairs are the map files).
+    VertexMaps,
 }
+
+/// The vertex-map datasets: name and folder under the data root.
+pub const VERTEX_MAP_DATASETS: [(&str, &str); 2] = [
+    ("camel_gallop", "nonisometric/camel_gallop"),
+    ("lion_cat", "nonisometric"),
+];
 
 impl Layout {
     /// The layout of a dataset with a known name: `faust`, `scape` share one vertex order,
@@ -83,6 +97,7 @@ impl Layout {
             "faust" | "scape" => Some(Layout::SharedOrder),
             "tosca" => Some(Layout::SharedOrderPerClass),
             n if n.ends_with("_r") => Some(Layout::Vts),
+            n if VERTEX_MAP_DATASETS.iter().any(|(d, _)| *d == n) => Some(Layout::VertexMaps),
             _ => None,
         }
     }
@@ -131,15 +146,21 @@ fn shape_extension(file_name: &str) -> bool {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Dataset {
     pub name: String,
-    /// `root/name`.
+    /// `root/name` (for [`Layout::VertexMaps`], the folder of [`VERTEX_MAP_DATASETS`]).
     pub folder: PathBuf,
     pub layout: Layout,
+    /// [`Layout::VertexMaps`]: every pair with its map file (source vertex -> target vertex).
+    pub vertex_maps: Vec<(Pair, PathBuf)>,
 }
 
 impl Dataset {
-    /// Dataset `name` under `root` (`root/name/`), its layout from its name or contents.
+    /// Dataset `name` under `root` (`root/name/`, or the folder of [`VERTEX_MAP_DATASETS`]),
+    /// its layout from its name or contents.
     pub fn open(root: &Path, name: &str) -> Result<Dataset> {
-        let folder = root.join(name);
+        let folder = match VERTEX_MAP_DATASETS.iter().find(|(d, _)| *d == name) {
+            Some((_, sub)) => root.join(sub),
+            None => root.join(name),
+        };
         if !folder.is_dir() {
             return Err(Error::file(
                 &folder,
@@ -153,11 +174,25 @@ impl Dataset {
             Some(layout) => layout,
             None => Layout::detect(&folder)?,
         };
+        let vertex_maps = match layout {
+            Layout::VertexMaps => vertex_map_pairs(name, &folder)?,
+            _ => Vec::new(),
+        };
         Ok(Dataset {
             name: name.to_string(),
             folder,
             layout,
+            vertex_maps,
         })
+    }
+
+    /// The dataset's pairs: `root/pairs/NAME.txt`, or for [`Layout::VertexMaps`] (which
+    /// have no pair list) its map files' pairs.
+    pub fn pairs(&self, root: &Path) -> Result<Vec<Pair>> {
+        match self.layout {
+            Layout::VertexMaps => Ok(self.vertex_maps.iter().map(|(p, _)| p.clone()).collect()),
+            _ => read_pairs(&self.pairs_file(root)),
+        }
     }
 
     /// The dataset a pair list belongs to: `pairs/NAME.txt` belongs to `NAME` under `root`.
@@ -178,7 +213,9 @@ impl Dataset {
     /// dataset folder (or its `off/` and `shapes/` subfolders for remeshed layouts).
     pub fn shape_path(&self, name: &str) -> Result<PathBuf> {
         let folders: Vec<PathBuf> = match self.layout {
-            Layout::SharedOrder | Layout::SharedOrderPerClass => vec![self.folder.clone()],
+            Layout::SharedOrder | Layout::SharedOrderPerClass | Layout::VertexMaps => {
+                vec![self.folder.clone()]
+            }
             Layout::Vts | Layout::TemplateIndex => vec![
                 self.folder.join("off"),
                 self.folder.join("shapes"),
@@ -330,7 +367,50 @@ impl Dataset {
                 };
                 Ok((truth, flipped))
             }
+            Layout::VertexMaps => Ok((
+                self.vertex_map_truth(source, target, n_source, n_target)?,
+                None,
+            )),
         }
+    }
+
+    /// [`Layout::VertexMaps`]: the map file's pairs `(x, map[x])`, checked against both sizes.
+    fn vertex_map_truth(
+        &self,
+        source: &str,
+        target: &str,
+        n_source: usize,
+        n_target: usize,
+    ) -> Result<VertexPairs> {
+        let (_, path) = self
+            .vertex_maps
+            .iter()
+            .find(|(p, _)| p.source == source && p.target == target)
+            .ok_or_else(|| Error::InvalidParameter {
+                name: "pair",
+                reason: format!(
+                    "{source} -> {target} has no map file in {}",
+                    self.folder.display()
+                ),
+            })?;
+        let map = read_indices(path, 0)?;
+        if map.len() != n_source {
+            return Err(Error::file(
+                path,
+                format!(
+                    "{} entries for the {n_source} vertices of {source}",
+                    map.len()
+                ),
+            ));
+        }
+        check_range(path, &map, n_target)?;
+        let placeholder = zero_placeholder(&map);
+        Ok(map
+            .into_iter()
+            .enumerate()
+            .filter(|&(_, y)| !(placeholder && y == 0))
+            .map(|(x, y)| (x as u32, y))
+            .collect())
     }
 
     /// The mirror map of a shared-order dataset (per class for TOSCA), checked against the
@@ -357,9 +437,99 @@ impl Dataset {
     }
 }
 
-/// The datasets under `root` that have both a folder and a pair list `pairs/NAME.txt`,
-/// sorted by name. Folders without a pair list (and pair lists without a folder) are
-/// skipped: they are listed in the second value with the reason.
+/// Whether target vertex 0 of a vertex map is a placeholder for "no correspondence": it is
+/// hit more than 4 times as often as any other vertex and by more than 20 sources. 27 of the
+/// 30 camel gallop maps send 430-910 vertices (spread over the whole animal, 0.4-0.5 away
+/// from vertex 0) to vertex 0, while no other vertex is hit more than 8 times; scoring those
+/// as pairs would count a correct map as wrong on 10-18% of the shape.
+pub fn zero_placeholder(map: &[u32]) -> bool {
+    let n = map.iter().map(|&y| y as usize + 1).max().unwrap_or(0);
+    let mut hits = vec![0usize; n];
+    for &y in map {
+        hits[y as usize] += 1;
+    }
+    let others = hits.iter().skip(1).copied().max().unwrap_or(0);
+    hits.first()
+        .is_some_and(|&zero| zero > 20 && zero > 4 * others)
+}
+
+/// The pairs of a vertex-map dataset (see [`VERTEX_MAP_DATASETS`]): `maps/i_to_j` between
+/// the shapes whose names end in the numbers i and j, or `lion2cat` for `lion-00` ->
+/// `cat-00`; sorted by source then target.
+fn vertex_map_pairs(name: &str, folder: &Path) -> Result<Vec<(Pair, PathBuf)>> {
+    if name == "lion_cat" {
+        let pair = Pair {
+            source: "lion-00".into(),
+            target: "cat-00".into(),
+            category: "lion_to_cat".into(),
+        };
+        return Ok(vec![(pair, folder.join("lion2cat"))]);
+    }
+    let maps = folder.join("maps");
+    let entries = std::fs::read_dir(&maps).map_err(|e| Error::file(&maps, e.to_string()))?;
+    let mut shapes: Vec<(u32, String)> = std::fs::read_dir(folder)
+        .map_err(|e| Error::file(folder, e.to_string()))?
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let file = e.file_name().to_string_lossy().into_owned();
+            let stem = file.rsplit_once('.').filter(|_| shape_extension(&file))?.0;
+            let digits = &stem[class_of(stem).len()..];
+            Some((digits.parse().ok()?, stem.to_string()))
+        })
+        .collect();
+    shapes.sort();
+    let shape_of = |frame: &str| -> Option<String> {
+        let frame: u32 = frame.parse().ok()?;
+        shapes
+            .iter()
+            .find(|(n, _)| *n == frame)
+            .map(|(_, s)| s.clone())
+    };
+    let mut pairs = Vec::new();
+    for entry in entries.filter_map(|e| e.ok()) {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some((i, j)) = file.split_once("_to_") else {
+            continue;
+        };
+        let (Some(source), Some(target)) = (shape_of(i), shape_of(j)) else {
+            return Err(Error::file(
+                entry.path(),
+                format!("no shape numbered {i} and {j} in {}", folder.display()),
+            ));
+        };
+        let pair = Pair {
+            source,
+            target,
+            category: name.to_string(),
+        };
+        pairs.push((pair, entry.path()));
+    }
+    if pairs.is_empty() {
+        return Err(Error::file(&maps, "no map file named i_to_j"));
+    }
+    pairs.sort_by(|(p, _), (q, _)| (&p.source, &p.target).cmp(&(&q.source, &q.target)));
+    Ok(pairs)
+}
+
+/// A pair list given as a file (`pairs/NAME.txt`, of the dataset `NAME` under `root`) or as
+/// the name of a dataset: the dataset and its pairs (the first `limit`).
+pub fn pair_list(root: &Path, list: &Path, limit: Option<usize>) -> Result<(Dataset, Vec<Pair>)> {
+    let (dataset, mut pairs) = if list.is_file() {
+        (Dataset::for_pairs_file(root, list)?, read_pairs(list)?)
+    } else {
+        let name = list.to_string_lossy();
+        let dataset = Dataset::open(root, &name)?;
+        let pairs = dataset.pairs(root)?;
+        (dataset, pairs)
+    };
+    pairs.truncate(limit.unwrap_or(usize::MAX));
+    Ok((dataset, pairs))
+}
+
+/// The datasets under `root` that have both a folder and a pair list `pairs/NAME.txt`, and
+/// the vertex-map datasets whose folders exist, sorted by name. Folders without a pair list
+/// (and pair lists without a folder) are skipped: they are listed in the second value with
+/// the reason.
 pub fn discover(root: &Path) -> Result<(Vec<Dataset>, Vec<String>)> {
     let pairs_dir = root.join("pairs");
     let entries = std::fs::read_dir(&pairs_dir).map_err(|e| {
@@ -375,7 +545,14 @@ pub fn discover(root: &Path) -> Result<(Vec<Dataset>, Vec<String>)> {
             name.strip_suffix(".txt").map(str::to_string)
         })
         .collect();
+    names.extend(
+        VERTEX_MAP_DATASETS
+            .iter()
+            .filter(|(_, folder)| root.join(folder).is_dir())
+            .map(|(name, _)| name.to_string()),
+    );
     names.sort();
+    names.dedup();
     let (mut found, mut skipped) = (Vec::new(), Vec::new());
     for name in names {
         match Dataset::open(root, &name) {

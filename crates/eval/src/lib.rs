@@ -8,7 +8,8 @@
 //! (the paper's Tables 1 and 3), [`bench_pointwise`] point-to-point maps (Table 2) and
 //! [`bench_clouds`] the point-cloud protocol; [`reeb`] is the Reeb-graph baseline;
 //! [`bench_store`] caches eigenbases and keeps resumable logs; [`bench_all`] runs every table
-//! and writes `docs/results.md`; [`plot`] draws the PNG figures.
+//! and writes `docs/results.md`; [`plot`] draws the PNG figures; [`tails`] summarises every
+//! score by its mean, median, worst pair and count of failed pairs.
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
@@ -20,3 +21,4 @@ pub mod bench_store;
 pub mod datasets;
 pub mod plot;
 pub mod reeb;
+pub mod tails;

@@ -430,5 +430,6 @@ pub fn reeb_correspondence(
         matches_one_to_one,
         candidates: vec![candidate],
         timings,
+        verdict: None,
     })
 }

@@ -55,7 +55,8 @@ pub struct BenchRegionsArgs {
     #[arg(long)]
     data: Option<PathBuf>,
     /// Pair list DATA/pairs/NAME.txt of the dataset in DATA/NAME (its layout from the
-    /// name or the folder's contents: see crates/eval/src/datasets.rs).
+    /// name or the folder's contents: see crates/eval/src/datasets.rs), or a dataset's
+    /// name (camel_gallop and lion_cat, which have no pair list, take their map files' pairs).
     #[arg(long)]
     pairs: PathBuf,
     /// Only the first N pairs.
@@ -103,6 +104,8 @@ impl BenchRegionsArgs {
             started.elapsed().as_secs_f64()
         );
         print!("{}", shapecorr_eval::bench::summary_table(&results));
+        println!();
+        print!("{}", shapecorr_eval::bench::region_tails_table(&results));
         Ok(())
     }
 }
@@ -113,7 +116,8 @@ pub struct BenchP2pArgs {
     #[arg(long)]
     data: Option<PathBuf>,
     /// Pair list DATA/pairs/NAME.txt of the dataset in DATA/NAME (its layout from the
-    /// name or the folder's contents: see crates/eval/src/datasets.rs).
+    /// name or the folder's contents: see crates/eval/src/datasets.rs), or a dataset's
+    /// name (camel_gallop and lion_cat, which have no pair list, take their map files' pairs).
     #[arg(long)]
     pairs: PathBuf,
     /// Only the first N pairs.
@@ -167,6 +171,11 @@ impl BenchP2pArgs {
         print!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_table(&results)
+        );
+        println!("\nTails (mean error per pair, flip allowed where a mirror map exists):\n");
+        print!(
+            "{}",
+            shapecorr_eval::bench_pointwise::pointwise_tails_table(&results)
         );
         if let Some(path) = &self.json {
             write_scores_json(path, &results)?;
@@ -305,6 +314,11 @@ impl BenchMapsArgs {
         print!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_table(&results)
+        );
+        println!("\nTails (mean error per pair, flip allowed where a mirror map exists):\n");
+        print!(
+            "{}",
+            shapecorr_eval::bench_pointwise::pointwise_tails_table(&results)
         );
         if let Some(path) = &self.json {
             write_scores_json(path, &results)?;

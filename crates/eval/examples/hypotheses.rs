@@ -1,0 +1,176 @@
+//! Which map energy tells a right region hypothesis from a wrong one (issue 18): for every
+//! pair of the datasets given, every hypothesis the default pipeline verifies, with its
+//! energies, its cost, whether it was chosen, and its full-resolution map's mean geodesic
+//! error against the ground truth (and with the flip allowed, where a mirror map exists). One JSON line
+//! per hypothesis on stdout; a summary per pair on stderr.
+//!
+//!     cargo run --release -p shapecorr-eval --example hypotheses -- \
+//!         [--data DIR] [--limit N] [--cache DIR] [--reverse] DATASET ...
+//!
+//! `--reverse` also runs every pair the other way (B to A), for the direction test;
+//! `--region-basis` verifies on the regions' basis (50 eigenpairs, ZoomOut to 50).
+
+use std::path::PathBuf;
+
+use shapecorr::correspondence::{Correspondence, Params};
+use shapecorr::maps::fmap::fmap_to_p2p;
+use shapecorr::maps::pointwise::{truncated, PointwiseMap, PointwiseParams};
+use shapecorr::progress::NoProgress;
+use shapecorr::spectral::eigen::EigenParams;
+use shapecorr_eval::bench_pointwise::score_maps;
+use shapecorr_eval::bench_store::{BasisCache, ShapeStore};
+use shapecorr_eval::datasets::{default_data_root, pair_list, Pair};
+
+fn main() -> shapecorr::Result<()> {
+    let mut args = std::env::args().skip(1);
+    let (mut data, mut limit, mut cache, mut reverse) = (default_data_root(), None, None, false);
+    let mut region_basis = false;
+    let mut datasets = Vec::new();
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--data" => data = PathBuf::from(args.next().expect("--data DIR")),
+            "--limit" => limit = args.next().and_then(|n| n.parse().ok()),
+            "--cache" => cache = args.next().map(PathBuf::from),
+            "--reverse" => reverse = true,
+            "--region-basis" => region_basis = true,
+            name => datasets.push(name.to_string()),
+        }
+    }
+    let params = Params::default();
+    let mut pointwise = PointwiseParams::default();
+    if region_basis {
+        // The verification on the regions' own basis (50 eigenpairs, ZoomOut to 50).
+        pointwise.n_eigenpairs = params.eigen.n_eigenpairs;
+        pointwise.refinement =
+            shapecorr::maps::pointwise::Refinement::ZoomOut(shapecorr::maps::fmap::ZoomOutParams {
+                k_end: params.eigen.n_eigenpairs,
+                ..Default::default()
+            });
+    }
+    for name in datasets {
+        let list = data.join("pairs").join(format!("{name}.txt"));
+        let spec = if list.is_file() {
+            list
+        } else {
+            PathBuf::from(&name)
+        };
+        let (dataset, pairs) = pair_list(&data, &spec, None)?;
+        let pairs = spread(&pairs, limit);
+        let eigen = EigenParams {
+            n_eigenpairs: PointwiseParams::default().n_eigenpairs,
+            ..params.eigen.clone()
+        };
+        let mut store = ShapeStore::new(dataset, eigen, BasisCache { dir: cache.clone() });
+        for pair in &pairs {
+            let mut runs = vec![pair.clone()];
+            if reverse {
+                runs.push(Pair {
+                    source: pair.target.clone(),
+                    target: pair.source.clone(),
+                    category: pair.category.clone(),
+                });
+            }
+            for run in runs {
+                if let Err(e) = one_pair(&mut store, &name, &run, &params, &pointwise) {
+                    eprintln!("{name} {} -> {}: {e}", run.source, run.target);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn one_pair(
+    store: &mut ShapeStore,
+    name: &str,
+    pair: &Pair,
+    params: &Params,
+    pointwise: &PointwiseParams,
+) -> shapecorr::Result<()> {
+    store.load(&pair.source, true, true)?;
+    store.load(&pair.target, true, false)?;
+    let (a, b) = (
+        &store.get(&pair.source).shape,
+        &store.get(&pair.target).shape,
+    );
+    let (basis_a, basis_b) = (
+        &store.basis(&pair.source).basis,
+        &store.basis(&pair.target).basis,
+    );
+    let regions = Correspondence::from_bases(
+        a,
+        &truncated(basis_a, params.eigen.n_eigenpairs),
+        b,
+        &truncated(basis_b, params.eigen.n_eigenpairs),
+        params,
+        &mut NoProgress,
+    )?;
+    let t = std::time::Instant::now();
+    let (basis_a, basis_b) = (
+        &truncated(basis_a, pointwise.n_eigenpairs),
+        &truncated(basis_b, pointwise.n_eigenpairs),
+    );
+    let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(&regions), pointwise)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let Some(verdict) = &map.verdict else {
+        eprintln!("{name} {} -> {}: one hypothesis", pair.source, pair.target);
+        return Ok(());
+    };
+    let maps: Vec<(String, Vec<u32>, f64)> = verdict
+        .scores
+        .iter()
+        .map(|h| {
+            let p2p = fmap_to_p2p(
+                h.fmap_ab.as_ref(),
+                basis_a.vectors.as_ref(),
+                basis_b.vectors.as_ref(),
+            );
+            (h.kind.name(), p2p, 0.0)
+        })
+        .collect();
+    let mut maps = maps;
+    maps.push(("final".into(), map.p2p_ba.clone(), 0.0));
+    let scores = score_maps(store, pair, &maps, 1000)?;
+    let final_error = scores.last().map_or(f64::NAN, |s| s.error.mean);
+    let mut summary = String::new();
+    for (i, (h, s)) in verdict.scores.iter().zip(&scores).enumerate() {
+        let e = &h.energy;
+        println!(
+            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"descriptor\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"seconds\":{seconds:.3}}}",
+            pair.source,
+            pair.target,
+            h.kind.name(),
+            i == verdict.chosen,
+            e.distortion,
+            e.coverage,
+            e.orientation.map_or("null".to_string(), |o| format!("{o:.5}")),
+            e.cost(),
+            e.residual,
+            e.descriptor,
+            s.error.mean,
+            s.best_mean(),
+            verdict.confidence,
+            h.distance_to_chosen,
+        );
+        summary.push_str(&format!(
+            " {}{}={:.3}/{:.4}",
+            if i == verdict.chosen { "*" } else { "" },
+            h.kind.name(),
+            s.error.mean,
+            e.cost()
+        ));
+    }
+    eprintln!(
+        "{name} {} -> {} final {final_error:.3} conf {:.2} {seconds:.2}s:{summary}",
+        pair.source, pair.target, verdict.confidence
+    );
+    Ok(())
+}
+
+/// At most `n` pairs spread over the list.
+fn spread(pairs: &[Pair], n: Option<usize>) -> Vec<Pair> {
+    match n {
+        Some(n) if n < pairs.len() => (0..n).map(|i| pairs[i * pairs.len() / n].clone()).collect(),
+        _ => pairs.to_vec(),
+    }
+}

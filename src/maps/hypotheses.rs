@@ -1,0 +1,787 @@
+//! Region hypotheses verified at the map level (docs/design.md, step 14; issue 18).
+//!
+//! A one-to-one region answer can be wrong in ways the region energy cannot see: the
+//! mirror image of the truth (paper, section 5.2), or two parts of one symmetric group
+//! swapped (a quadruped's front and back legs). Instead of committing to one answer, the
+//! few best candidates ([`candidates`]: the answer, its mirror image, the symmetric groups
+//! with no choice made inside them, and the best single-group alternatives) are each turned
+//! into a functional map, refined by ZoomOut on vertex samples, and judged by an energy of
+//! the refined map that needs no ground truth ([`MapEnergy`]): the geodesic distortion of
+//! the sample map, the fraction of A's samples it reaches and, on orientable meshes, the
+//! fraction of B's sample triangles whose orientation it keeps. The gap between the best
+//! and the runner-up gives the confidence of the answer ([`Verdict`]).
+
+use rayon::prelude::*;
+
+use crate::correspondence::Correspondence;
+use crate::geodesic::EdgeGraph;
+use crate::maps::fmap::SampledZoomOut;
+use crate::shape::Shape;
+use crate::spectral::eigen::Eigenbasis;
+
+/// Corresponding region sets: the A regions and the B regions of each constraint.
+pub type RegionGroups = Vec<(Vec<u32>, Vec<u32>)>;
+
+/// Where a hypothesis comes from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum HypothesisKind {
+    /// The one-to-one region answer.
+    Answer,
+    /// Its mirror image: another matching in every symmetric group.
+    Mirror,
+    /// The symmetric groups as constraints, no choice made inside a group (the orientation
+    /// term and the refinement decide).
+    Symmetric,
+    /// The answer with the matching of one symmetric group (its index among the groups with
+    /// a choice) replaced by another.
+    Alternative(usize),
+}
+
+impl HypothesisKind {
+    /// A short name: `answer`, `mirror`, `symmetric`, `alternative N`.
+    pub fn name(&self) -> String {
+        match self {
+            HypothesisKind::Answer => "answer".into(),
+            HypothesisKind::Mirror => "mirror".into(),
+            HypothesisKind::Symmetric => "symmetric".into(),
+            HypothesisKind::Alternative(g) => format!("alternative {g}"),
+        }
+    }
+}
+
+/// The energy of a map refined on samples, all from the two shapes and the map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct MapEnergy {
+    /// Mean `|d_B(s, v) - d_A(T s, T v)|` over well-spread sources `s` and all samples `v`
+    /// of B, edge-graph geodesics on the unit-area shapes.
+    pub distortion: f64,
+    /// Fraction of A's samples that B's samples reach.
+    pub coverage: f64,
+    /// Fraction of B's sample triangles whose image keeps its orientation (orientable
+    /// meshes only).
+    pub orientation: Option<f64>,
+    /// ZoomOut's reconstruction residual: `sum |Phi_b[v] - Phi_a[T v] C^T|^2 / sum
+    /// |Phi_b[v]|^2` over B's samples, in the final basis. A near-isometry is reproduced by
+    /// the spectral embedding; a map that sends the front of a body to its back is not.
+    pub residual: f64,
+    /// Mean relative disagreement of the wave kernel signatures (Aubry et al. 2011) of
+    /// every sample of B and its image: `|W_b(v) - W_a(T v)|^2 / |W_b(v)|^2`, each energy's
+    /// column scaled to unit mean square on its shape. The left/right mirror of a body is
+    /// a near-exact intrinsic symmetry, its front/back swap is not: the feet, face and
+    /// knees tell.
+    pub descriptor: f64,
+}
+
+impl MapEnergy {
+    /// The cost the hypotheses are ranked by (lower is better): the distortion, divided by
+    /// the coverage and by the orientation kept where it is known. A swapped part stretches
+    /// distances; a fold reaches fewer samples; a mirror image turns triangles over.
+    pub fn cost(&self) -> f64 {
+        self.distortion / (self.coverage.max(1e-3) * self.orientation.unwrap_or(1.0).max(1e-3))
+    }
+}
+
+/// One hypothesis and what the verification found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HypothesisScore {
+    /// Where it comes from.
+    pub kind: HypothesisKind,
+    /// The energy of its map refined on the samples.
+    pub energy: MapEnergy,
+    /// That map (`fmap_ab`, ZoomOut's final size).
+    pub fmap_ab: faer::Mat<f64>,
+    /// Mean distance between the images of B's samples under this map and the chosen one,
+    /// on the unit-area A (0 for the chosen one).
+    pub distance_to_chosen: f64,
+}
+
+/// The choice among the hypotheses and how sure it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verdict {
+    /// Index of the chosen hypothesis in `scores`.
+    pub chosen: usize,
+    /// Every hypothesis verified, in the order they were made.
+    pub scores: Vec<HypothesisScore>,
+    /// In [0, 1]: high when the chosen map is consistent and clearly better than the
+    /// runner-up ([`confidence`]).
+    pub confidence: f64,
+}
+
+/// Below this confidence an answer is reported as doubtful (calibrated on the development
+/// data, docs/decisions.md).
+pub const DOUBTFUL_BELOW: f64 = 0.5;
+
+impl Verdict {
+    /// The chosen hypothesis.
+    pub fn chosen(&self) -> &HypothesisScore {
+        &self.scores[self.chosen]
+    }
+
+    /// True when the confidence is below [`DOUBTFUL_BELOW`].
+    pub fn doubtful(&self) -> bool {
+        self.confidence < DOUBTFUL_BELOW
+    }
+
+    /// What to tell the user when the answer is doubtful: whether another, different
+    /// hypothesis came close or the chosen map itself is poor; None when it is not doubtful.
+    pub fn warning(&self) -> Option<String> {
+        if !self.doubtful() {
+            return None;
+        }
+        let best = self.chosen().energy.cost();
+        let rival = self
+            .scores
+            .iter()
+            .filter(|s| s.distance_to_chosen > DIFFERENT_MAP)
+            .min_by(|x, y| x.energy.cost().total_cmp(&y.energy.cost()));
+        Some(match rival {
+            Some(r) if r.energy.cost() < best * (1.0 + MARGIN_SCALE) => format!(
+                "doubtful correspondence (confidence {:.2}): the {} hypothesis is almost as consistent as the chosen {} and gives a different map (parts may be swapped or mirrored)",
+                self.confidence,
+                r.kind.name(),
+                self.chosen().kind.name()
+            ),
+            _ => format!(
+                "doubtful correspondence (confidence {:.2}): the best map found is not consistent (distortion {:.3}); the shapes may differ too much",
+                self.confidence,
+                self.chosen().energy.distortion
+            ),
+        })
+    }
+}
+
+/// Largest number of alternative matchings enumerated for one symmetric group (a 4x4
+/// group of two left/right pairs has 23); a group with more keeps its current matching.
+const OPTIONS_CAP: usize = 5040;
+
+/// Single-group alternatives kept as hypotheses, the best by region distortion.
+pub const MAX_ALTERNATIVES: usize = 3;
+
+/// The hypotheses to verify: the answer, its mirror image (`with_mirror`, orientable meshes:
+/// on point clouds a mirror image is as right as the answer), the symmetric groups, and up
+/// to [`MAX_ALTERNATIVES`] single-group alternatives ranked by the distortion of region
+/// distances. Duplicates are left out.
+pub fn candidates(
+    (a, basis_a): (&Shape, &Eigenbasis),
+    (b, basis_b): (&Shape, &Eigenbasis),
+    regions: &Correspondence,
+    with_mirror: bool,
+) -> Vec<(HypothesisKind, RegionGroups)> {
+    let answer = one_to_one_groups(&regions.matches_one_to_one);
+    let mut out = vec![(HypothesisKind::Answer, answer)];
+    let symmetric = crate::regions::symmetry::bipartite_groups(&regions.matches);
+    let choices = GroupChoices::new(regions);
+    if !choices.options.is_empty() {
+        let d_a = crate::geodesic::region_distance_matrix(
+            a,
+            &basis_a.mass,
+            regions.regions_a(),
+            regions.graph_a.n_nodes(),
+            1.0 / basis_a.input_area.sqrt(),
+        );
+        let d_b = crate::geodesic::region_distance_matrix(
+            b,
+            &basis_b.mass,
+            regions.regions_b(),
+            regions.graph_b.n_nodes(),
+            1.0 / basis_b.input_area.sqrt(),
+        );
+        let energy = |pick: &[Option<usize>]| {
+            crate::regions::symmetry::distortion_energy(
+                &choices.assemble(pick),
+                d_a.as_ref(),
+                d_b.as_ref(),
+            )
+        };
+        if with_mirror {
+            out.push((
+                HypothesisKind::Mirror,
+                one_to_one_groups(&choices.assemble(&choices.mirror(&energy))),
+            ));
+        }
+        let mut alternatives: Vec<(f64, usize, usize)> = Vec::new();
+        for (g, options) in choices.options.iter().enumerate() {
+            for o in 0..options.len() {
+                let mut pick = vec![None; choices.options.len()];
+                pick[g] = Some(o);
+                alternatives.push((energy(&pick), g, o));
+            }
+        }
+        alternatives.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        for (_, g, o) in alternatives {
+            if out.len() >= 2 + usize::from(with_mirror) + MAX_ALTERNATIVES {
+                break;
+            }
+            let mut pick = vec![None; choices.options.len()];
+            pick[g] = Some(o);
+            let groups = one_to_one_groups(&choices.assemble(&pick));
+            if !out.iter().any(|(_, h)| *h == groups) {
+                out.push((HypothesisKind::Alternative(g), groups));
+            }
+        }
+    }
+    if symmetric.len() < regions.matches.len() && !out.iter().any(|(_, h)| *h == symmetric) {
+        out.insert(1, (HypothesisKind::Symmetric, symmetric));
+    }
+    out
+}
+
+/// One constraint per one-to-one match, sorted by A region.
+fn one_to_one_groups(pairs: &[(u32, u32)]) -> RegionGroups {
+    let mut pairs = pairs.to_vec();
+    pairs.sort_unstable();
+    pairs.into_iter().map(|(i, j)| (vec![i], vec![j])).collect()
+}
+
+/// The one-to-one answer split into the matches no choice can change (`fixed`) and, per
+/// symmetric group with a choice, the answer's matching and the other maximum matchings.
+struct GroupChoices {
+    fixed: Vec<(u32, u32)>,
+    current: Vec<Vec<(u32, u32)>>,
+    options: Vec<Vec<Vec<(u32, u32)>>>,
+}
+
+impl GroupChoices {
+    fn new(regions: &Correspondence) -> GroupChoices {
+        let answer = &regions.matches_one_to_one;
+        let mut choices = GroupChoices {
+            fixed: Vec::new(),
+            current: Vec::new(),
+            options: Vec::new(),
+        };
+        for (ra, rb) in crate::regions::symmetry::bipartite_groups(&regions.matches) {
+            let in_group = |p: &(u32, u32)| ra.binary_search(&p.0).is_ok();
+            let mut mine: Vec<(u32, u32)> = answer.iter().copied().filter(in_group).collect();
+            mine.sort_unstable();
+            let edges: Vec<(u32, u32)> = regions.matches.iter().copied().filter(in_group).collect();
+            let (options, complete) =
+                crate::regions::symmetry::max_matchings(&ra, &rb, &edges, OPTIONS_CAP + 1);
+            // Each option lists its pairs by ascending A region, as `mine` does.
+            let others: Vec<Vec<(u32, u32)>> = options
+                .into_iter()
+                .filter(|m| m.len() == mine.len() && *m != mine)
+                .collect();
+            if ra.len() + rb.len() <= 2 || others.is_empty() || !complete {
+                choices.fixed.extend(mine);
+            } else {
+                choices.current.push(mine);
+                choices.options.push(others);
+            }
+        }
+        choices
+    }
+
+    /// The one-to-one pairs with group `g` taking `pick[g]` (None: the answer's matching).
+    fn assemble(&self, pick: &[Option<usize>]) -> Vec<(u32, u32)> {
+        let mut pairs = self.fixed.clone();
+        for (g, choice) in pick.iter().enumerate() {
+            match choice {
+                Some(o) => pairs.extend(&self.options[g][*o]),
+                None => pairs.extend(&self.current[g]),
+            }
+        }
+        pairs
+    }
+
+    /// The mirror image of the answer: every group with a choice takes another matching
+    /// (for a left/right pair: the swap), chosen together to minimise `energy` by a few
+    /// sweeps of coordinate descent. A region may keep its partner: a centaur's group of
+    /// two arms and a middle region mirrors by swapping the arms only.
+    fn mirror(&self, energy: &dyn Fn(&[Option<usize>]) -> f64) -> Vec<Option<usize>> {
+        let mut pick: Vec<Option<usize>> = vec![Some(0); self.options.len()];
+        for _sweep in 0..4 {
+            let mut changed = false;
+            for g in 0..self.options.len() {
+                let mut best = (energy(&pick), pick[g]);
+                for o in 0..self.options[g].len() {
+                    let mut trial = pick.clone();
+                    trial[g] = Some(o);
+                    let e = energy(&trial);
+                    if e < best.0 - 1e-12 {
+                        best = (e, Some(o));
+                    }
+                }
+                if best.1 != pick[g] {
+                    pick[g] = best.1;
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        pick
+    }
+}
+
+/// Geodesic sources on B spread by farthest-point sampling among the samples, and their
+/// distances to every vertex of B: computed once per pair, shared by every hypothesis.
+pub struct DistortionProbe {
+    graph_a: EdgeGraph,
+    /// Positions (in B's sample) of the sources.
+    sources: Vec<usize>,
+    /// Per source, the distance on B to every sample of B.
+    distances_b: Vec<Vec<f64>>,
+}
+
+/// Geodesic sources per pair for the distortion energy. 32 sources x 2000 samples: a
+/// relative spread of the estimate well under the gaps it has to see.
+pub const DISTORTION_SOURCES: usize = 32;
+
+impl DistortionProbe {
+    /// Sources among `samples_b` (vertices of B), the first the sample nearest B's first
+    /// sample, each next one the farthest from those chosen.
+    pub fn new(a: &Shape, scale_a: f64, b: &Shape, scale_b: f64, samples_b: &[u32]) -> Self {
+        let graph_b = EdgeGraph::new(b, scale_b);
+        let mut sources = Vec::with_capacity(DISTORTION_SOURCES);
+        let mut distances_b: Vec<Vec<f64>> = Vec::new();
+        let mut nearest = vec![f64::INFINITY; samples_b.len()];
+        let mut next = 0usize;
+        while sources.len() < DISTORTION_SOURCES.min(samples_b.len()) {
+            sources.push(next);
+            let all = graph_b.distances(&[samples_b[next]]);
+            let on_samples: Vec<f64> = samples_b.iter().map(|&v| all[v as usize]).collect();
+            for (n, d) in nearest.iter_mut().zip(&on_samples) {
+                *n = n.min(*d);
+            }
+            distances_b.push(on_samples);
+            next = (0..nearest.len())
+                .filter(|&s| nearest[s].is_finite())
+                .fold(
+                    0,
+                    |best, s| if nearest[s] > nearest[best] { s } else { best },
+                );
+            if nearest[next] == 0.0 {
+                break;
+            }
+        }
+        DistortionProbe {
+            graph_a: EdgeGraph::new(a, scale_a),
+            sources,
+            distances_b,
+        }
+    }
+
+    /// The mean distortion of the sample map `p2p_ba` (one vertex of A per sample of B):
+    /// `|d_B(s, v) - d_A(T s, T v)|` over the sources `s` and the samples `v`, pairs
+    /// unreachable on either shape left out.
+    pub fn distortion(&self, p2p_ba: &[u32]) -> f64 {
+        let per_source: Vec<(f64, usize)> = self
+            .sources
+            .par_iter()
+            .zip(&self.distances_b)
+            .map(|(&s, d_b)| {
+                let d_a = self.graph_a.distances(&[p2p_ba[s]]);
+                let (mut sum, mut count) = (0.0, 0usize);
+                for (v, &db) in d_b.iter().enumerate() {
+                    let da = d_a[p2p_ba[v] as usize];
+                    if da.is_finite() && db.is_finite() {
+                        sum += (da - db).abs();
+                        count += 1;
+                    }
+                }
+                (sum, count)
+            })
+            .collect();
+        let (sum, count) = per_source
+            .iter()
+            .fold((0.0, 0usize), |(s, c), &(x, n)| (s + x, c + n));
+        if count == 0 {
+            f64::INFINITY
+        } else {
+            sum / count as f64
+        }
+    }
+}
+
+/// The energies of hypotheses refined on the same samples, with the orientation of B's
+/// sample triangles where both shapes have consistently oriented `faces`.
+pub fn energies(
+    (a, basis_a): (&Shape, &Eigenbasis),
+    (b, basis_b): (&Shape, &Eigenbasis),
+    faces: Option<&(Vec<[u32; 3]>, Vec<[u32; 3]>)>,
+    sampled: &[SampledZoomOut],
+) -> Vec<MapEnergy> {
+    let Some(first) = sampled.first() else {
+        return Vec::new();
+    };
+    let probe = DistortionProbe::new(
+        a,
+        1.0 / basis_a.input_area.sqrt(),
+        b,
+        1.0 / basis_b.input_area.sqrt(),
+        &first.sample_b.vertices,
+    );
+    let oriented = faces.map(|(faces_a, faces_b)| {
+        let triangles_b = sample_triangles(
+            b.vertices(),
+            &vertex_normals(b.vertices(), faces_b),
+            &first.sample_b.vertices,
+        );
+        (vertex_normals(a.vertices(), faces_a), triangles_b)
+    });
+    let signature = |basis: &Eigenbasis| {
+        crate::spectral::descriptors::wks(
+            basis,
+            &crate::spectral::descriptors::WksParams::default(),
+        )
+        .ok()
+        .map(|w| unit_mean_square_columns(&w, &basis.mass))
+    };
+    let (wks_a, wks_b) = (signature(basis_a), signature(basis_b));
+    sampled
+        .iter()
+        .map(|s| MapEnergy {
+            descriptor: match (&wks_a, &wks_b) {
+                (Some(wa), Some(wb)) => disagreement(wa, wb, &s.sample_b.vertices, &s.p2p_ba),
+                _ => 0.0,
+            },
+            residual: residual(s, basis_a, basis_b),
+            distortion: probe.distortion(&s.p2p_ba),
+            coverage: covered_vertices(&s.p2p_ba, a.n_vertices()) as f64
+                / s.sample_a.vertices.len().max(1) as f64,
+            orientation: oriented.as_ref().map(|(normals_a, triangles_b)| {
+                sample_orientation((a.vertices(), normals_a), triangles_b, &s.p2p_ba)
+            }),
+        })
+        .collect()
+}
+
+/// Every column scaled to unit mass-weighted mean square.
+fn unit_mean_square_columns(w: &faer::Mat<f64>, mass: &[f64]) -> faer::Mat<f64> {
+    let total: f64 = mass.iter().sum();
+    let scale: Vec<f64> = (0..w.ncols())
+        .map(|j| {
+            let ms: f64 = (0..w.nrows())
+                .map(|v| mass[v] * w[(v, j)].powi(2))
+                .sum::<f64>()
+                / total.max(1e-300);
+            if ms > 0.0 {
+                1.0 / ms.sqrt()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    faer::Mat::from_fn(w.nrows(), w.ncols(), |v, j| w[(v, j)] * scale[j])
+}
+
+/// [`MapEnergy::descriptor`]: samples `samples_b` of B and their images `p2p_ba` on A.
+fn disagreement(
+    wa: &faer::Mat<f64>,
+    wb: &faer::Mat<f64>,
+    samples_b: &[u32],
+    p2p_ba: &[u32],
+) -> f64 {
+    let (mut misfit, mut norm) = (0.0, 0.0);
+    for (&v, &x) in samples_b.iter().zip(p2p_ba) {
+        for j in 0..wa.ncols().min(wb.ncols()) {
+            let target = wb[(v as usize, j)];
+            misfit += (target - wa[(x as usize, j)]).powi(2);
+            norm += target * target;
+        }
+    }
+    misfit / norm.max(1e-300)
+}
+
+/// [`MapEnergy::residual`] of a map refined on samples.
+fn residual(s: &SampledZoomOut, basis_a: &Eigenbasis, basis_b: &Eigenbasis) -> f64 {
+    let c = s.fmap_ab.as_ref();
+    let (k_b, k_a) = (c.nrows(), c.ncols());
+    let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+    let (mut misfit, mut norm) = (0.0, 0.0);
+    for (&v, &x) in s.sample_b.vertices.iter().zip(&s.p2p_ba) {
+        for i in 0..k_b {
+            let mut image = 0.0;
+            for j in 0..k_a {
+                image += phi_a[(x as usize, j)] * c[(i, j)];
+            }
+            let target = phi_b[(v as usize, i)];
+            misfit += (target - image).powi(2);
+            norm += target * target;
+        }
+    }
+    misfit / norm.max(1e-300)
+}
+
+/// The hypothesis of lowest [`MapEnergy::cost`] (the first among equals) and the verdict.
+/// `sample_maps`: each hypothesis's map from B's samples to vertices of A (`va`, whose
+/// area is `area_a`), to tell which hypotheses give a different map.
+pub fn choose(
+    kinds: Vec<HypothesisKind>,
+    energies: Vec<MapEnergy>,
+    fmaps: Vec<faer::Mat<f64>>,
+    sample_maps: &[&[u32]],
+    (va, area_a): (&[[f64; 3]], f64),
+) -> Verdict {
+    let costs: Vec<f64> = energies.iter().map(MapEnergy::cost).collect();
+    let chosen = (1..costs.len()).fold(0, |best, c| if costs[c] < costs[best] { c } else { best });
+    let scale = 1.0 / area_a.sqrt();
+    let scores: Vec<HypothesisScore> = kinds
+        .into_iter()
+        .zip(energies)
+        .zip(fmaps)
+        .enumerate()
+        .map(|(h, ((kind, energy), fmap_ab))| HypothesisScore {
+            kind,
+            energy,
+            fmap_ab,
+            distance_to_chosen: mean_image_distance(sample_maps[h], sample_maps[chosen], va)
+                * scale,
+        })
+        .collect();
+    let confidence = confidence(&scores, chosen);
+    Verdict {
+        chosen,
+        scores,
+        confidence,
+    }
+}
+
+/// Mean Euclidean distance between the images of the same samples under two maps.
+fn mean_image_distance(p: &[u32], q: &[u32], va: &[[f64; 3]]) -> f64 {
+    let sum: f64 = p
+        .iter()
+        .zip(q)
+        .map(|(&x, &y)| {
+            let (u, v) = (va[x as usize], va[y as usize]);
+            ((u[0] - v[0]).powi(2) + (u[1] - v[1]).powi(2) + (u[2] - v[2]).powi(2)).sqrt()
+        })
+        .sum();
+    sum / p.len().max(1) as f64
+}
+
+/// A hypothesis whose map differs from the chosen one by more than this (mean distance
+/// between the images of B's samples, on the unit-area A) is a competitor: a different
+/// answer, not the same map reached from other constraints.
+pub const DIFFERENT_MAP: f64 = 0.05;
+
+/// The confidence of the chosen hypothesis: the product of how consistent its map is (its
+/// cost against [`COST_SCALE`]) and how clearly it beats the best competitor (a hypothesis
+/// whose map differs by more than [`DIFFERENT_MAP`]; the relative cost margin against
+/// [`MARGIN_SCALE`]). No competitor: margin factor 1. In [0, 1].
+pub fn confidence(scores: &[HypothesisScore], chosen: usize) -> f64 {
+    let best = scores[chosen].energy.cost();
+    let consistency = (-best / COST_SCALE).exp();
+    let runner_up = scores
+        .iter()
+        .filter(|s| s.distance_to_chosen > DIFFERENT_MAP)
+        .map(|s| s.energy.cost())
+        .fold(f64::INFINITY, f64::min);
+    let margin = if runner_up.is_finite() {
+        let relative = (runner_up - best) / runner_up.max(1e-12);
+        1.0 - (-relative.max(0.0) / MARGIN_SCALE).exp()
+    } else {
+        1.0
+    };
+    (consistency * margin).clamp(0.0, 1.0)
+}
+
+/// The cost at which the consistency factor of the confidence is 1/e.
+pub const COST_SCALE: f64 = 0.2;
+/// The relative cost margin at which the margin factor of the confidence is 1 - 1/e.
+pub const MARGIN_SCALE: f64 = 0.1;
+
+/// Number of distinct vertices of A that the map reaches.
+pub(crate) fn covered_vertices(p2p_ba: &[u32], n_a: usize) -> usize {
+    let mut hit = vec![false; n_a];
+    for &v in p2p_ba {
+        hit[v as usize] = true;
+    }
+    hit.into_iter().filter(|&h| h).count()
+}
+
+/// Nearest samples searched for the corners of a sample triangle.
+const TRIANGLE_NEIGHBOURS: usize = 12;
+
+/// Triangles of B's samples, large enough that the noise of a sample map (about one sample
+/// spacing) cannot turn them over: each sample with its [`TRIANGLE_NEIGHBOURS`]/2-th nearest
+/// sample and, among its [`TRIANGLE_NEIGHBOURS`] nearest, the one making the fattest
+/// triangle; as positions in `samples_b`, with whether it turns counter-clockwise about B's
+/// vertex normals (degenerate ones left out). The smallest triangles (a sample and its two
+/// nearest) kept only 70% of their orientation under right maps of FAUST_r pairs, no more
+/// than under maps with a mirrored half.
+fn sample_triangles(
+    vb: &[[f64; 3]],
+    normals_b: &[[f64; 3]],
+    samples_b: &[u32],
+) -> Vec<([usize; 3], bool)> {
+    let points: Vec<[f64; 3]> = samples_b.iter().map(|&v| vb[v as usize]).collect();
+    let tree = crate::shape::neighbors::PointTree::new(&points);
+    let mut triangles = Vec::with_capacity(points.len());
+    for (s, p) in points.iter().enumerate() {
+        let near: Vec<usize> = tree
+            .nearest_k(p, TRIANGLE_NEIGHBOURS + 1)
+            .into_iter()
+            .map(|(j, _)| j)
+            .filter(|&j| j != s)
+            .collect();
+        let Some(&j) = near.get(TRIANGLE_NEIGHBOURS / 2 - 1) else {
+            continue;
+        };
+        let u = crate::shape::sub(&points[j], p);
+        let fatness = |l: usize| {
+            let w = crate::shape::sub(&points[l], p);
+            let c = crate::shape::cross(&u, &w);
+            crate::shape::dot(&c, &c)
+                / (crate::shape::dot(&w, &w) * crate::shape::dot(&u, &u)).max(1e-300)
+        };
+        let Some(l) = near
+            .iter()
+            .copied()
+            .filter(|&l| l != j)
+            .max_by(|&x, &y| fatness(x).total_cmp(&fatness(y)))
+        else {
+            continue;
+        };
+        let corners = [s, j, l];
+        let turn = signed_turn(vb, corners.map(|c| samples_b[c] as usize), normals_b);
+        if turn != 0.0 {
+            triangles.push((corners, turn > 0.0));
+        }
+    }
+    triangles
+}
+
+/// The fraction of B's [`sample_triangles`] whose image under the sample map keeps its
+/// orientation (judged by A's vertex normals of its oriented faces).
+fn sample_orientation(
+    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
+    triangles_b: &[([usize; 3], bool)],
+    p2p_ba: &[u32],
+) -> f64 {
+    let (mut kept, mut total) = (0usize, 0usize);
+    for (corners, counter_clockwise) in triangles_b {
+        let images = corners.map(|c| p2p_ba[c] as usize);
+        let turn = signed_turn(va, images, normals_a);
+        if turn != 0.0 {
+            total += 1;
+            if (turn > 0.0) == *counter_clockwise {
+                kept += 1;
+            }
+        }
+    }
+    kept as f64 / total.max(1) as f64
+}
+
+/// Fraction of B's triangles whose image under `p2p_ba` keeps its orientation on A
+/// (the mapped triangle's normal agrees with A's vertex normals there), both shapes' faces
+/// taken as [`Shape::oriented_triangles`]; `None` when either shape is a point cloud or
+/// not orientable, or no triangle maps to a proper triangle.
+pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
+    let normals_a = vertex_normals(a.vertices(), &a.oriented_triangles()?);
+    let (mut kept, mut total) = (0usize, 0usize);
+    for t in &b.oriented_triangles()? {
+        let turn = signed_turn(
+            a.vertices(),
+            t.map(|v| p2p_ba[v as usize] as usize),
+            &normals_a,
+        );
+        if turn != 0.0 {
+            total += 1;
+            if turn > 0.0 {
+                kept += 1;
+            }
+        }
+    }
+    (total > 0).then(|| kept as f64 / total as f64)
+}
+
+/// Area-weighted vertex normals (not normalised) of oriented faces.
+fn vertex_normals(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<[f64; 3]> {
+    let mut normals = vec![[0.0; 3]; vertices.len()];
+    for t in faces {
+        let [p, q, r] = t.map(|v| vertices[v as usize]);
+        let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
+        for &v in t {
+            for c in 0..3 {
+                normals[v as usize][c] += n[c];
+            }
+        }
+    }
+    normals
+}
+
+/// The triangle of three vertices, seen against their summed vertex normals: positive when it
+/// turns counter-clockwise about them, negative when clockwise, 0 when two corners coincide.
+fn signed_turn(vertices: &[[f64; 3]], c: [usize; 3], normals: &[[f64; 3]]) -> f64 {
+    if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
+        return 0.0;
+    }
+    let [p, q, r] = c.map(|v| vertices[v]);
+    let n = crate::shape::cross(&crate::shape::sub(&q, &p), &crate::shape::sub(&r, &p));
+    let reference: [f64; 3] =
+        std::array::from_fn(|i| normals[c[0]][i] + normals[c[1]][i] + normals[c[2]][i]);
+    crate::shape::dot(&n, &reference)
+}
+
+/// The one-to-one region matches that agree best with a vertex map `p2p_ba`: in every
+/// symmetric group with a choice, the maximum matching whose pairs `(i, j)` hold the most of
+/// B's area (`mass_b`) in region `j` mapped into region `i` of A; the other matches as they
+/// are. Sorted by A region. This keeps the regions reported with a map consistent with it.
+pub fn one_to_one_from_map(
+    regions: &Correspondence,
+    p2p_ba: &[u32],
+    mass_b: &[f64],
+) -> Vec<(u32, u32)> {
+    let choices = GroupChoices::new(regions);
+    let (labels_a, labels_b) = (regions.regions_a(), regions.regions_b());
+    let n_a = regions.graph_a.n_nodes();
+    let mut overlap = vec![0.0; n_a * regions.graph_b.n_nodes()];
+    for (v, &x) in p2p_ba.iter().enumerate() {
+        let (i, j) = (labels_a[x as usize] as usize, labels_b[v] as usize);
+        overlap[j * n_a + i] += mass_b[v];
+    }
+    let held = |pairs: &[(u32, u32)]| -> f64 {
+        pairs
+            .iter()
+            .map(|&(i, j)| overlap[j as usize * n_a + i as usize])
+            .sum()
+    };
+    let pick: Vec<Option<usize>> = choices
+        .options
+        .iter()
+        .zip(&choices.current)
+        .map(|(options, current)| {
+            let mut best = (held(current), None);
+            for (o, option) in options.iter().enumerate() {
+                let h = held(option);
+                if h > best.0 {
+                    best = (h, Some(o));
+                }
+            }
+            best.1
+        })
+        .collect();
+    let mut pairs = choices.assemble(&pick);
+    pairs.sort_unstable();
+    pairs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::{figure_poses, mirror_map, FigureKind, Proportions};
+
+    /// On a generated humanoid in two poses (one vertex order): the identity keeps the
+    /// orientation of nearly every sample triangle, the exact mirror map of nearly none.
+    #[test]
+    fn sample_orientation_tells_a_map_from_its_mirror_image() {
+        let meshes =
+            figure_poses(FigureKind::Humanoid, 3000, Proportions::default(), &[0, 2]).unwrap();
+        let mirror = mirror_map(&meshes[0]);
+        let (a, b) = (&meshes[0], &meshes[1]);
+        let normals_a = vertex_normals(&a.vertices, &a.triangles);
+        let normals_b = vertex_normals(&b.vertices, &b.triangles);
+        let samples: Vec<u32> = (0..b.vertices.len() as u32).step_by(3).collect();
+        let triangles = sample_triangles(&b.vertices, &normals_b, &samples);
+        let identity: Vec<u32> = samples.clone();
+        let mirrored: Vec<u32> = samples.iter().map(|&v| mirror[v as usize]).collect();
+        let kept = sample_orientation((&a.vertices, &normals_a), &triangles, &identity);
+        let kept_mirrored = sample_orientation((&a.vertices, &normals_a), &triangles, &mirrored);
+        assert!(kept > 0.95, "identity keeps {kept}");
+        assert!(kept_mirrored < 0.05, "mirror keeps {kept_mirrored}");
+    }
+}
