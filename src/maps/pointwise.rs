@@ -229,7 +229,10 @@ impl PointwiseMap {
             None
         };
         let kinds_and_groups: Vec<(HypothesisKind, RegionGroups)> = match regions {
-            Some(regions) if params.regions == RegionConstraints::OneToOne => {
+            // Regions verified already ([`verify_regions`]): their answer is the hypothesis.
+            Some(regions)
+                if params.regions == RegionConstraints::OneToOne && regions.verdict.is_none() =>
+            {
                 let with_mirror = params.orientation && faces.is_some();
                 if params.hypotheses {
                     hypotheses::candidates((a, basis_a), (b, basis_b), regions, with_mirror)

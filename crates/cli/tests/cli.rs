@@ -418,7 +418,7 @@ fn help_lists_one_flag_per_option_of_the_table() {
         (&["symmetry", "--help"], &["--out", "--points"]),
         (
             &["bench", "regions", "--help"],
-            &["--data", "--pairs", "--limit"],
+            &["--data", "--pairs", "--limit", "--basis-cache"],
         ),
     ] {
         let mut flags = help_flags(command);

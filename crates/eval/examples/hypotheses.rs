@@ -112,7 +112,7 @@ fn one_pair(
     );
     let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(&regions), pointwise)?;
     let seconds = t.elapsed().as_secs_f64();
-    let Some(verdict) = &map.verdict else {
+    let Some(verdict) = map.verdict.as_ref().or(regions.verdict.as_ref()) else {
         eprintln!("{name} {} -> {}: one hypothesis", pair.source, pair.target);
         return Ok(());
     };
@@ -136,7 +136,7 @@ fn one_pair(
     for (i, (h, s)) in verdict.scores.iter().zip(&scores).enumerate() {
         let e = &h.energy;
         println!(
-            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"descriptor\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"seconds\":{seconds:.3}}}",
+            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"seconds\":{seconds:.3}}}",
             pair.source,
             pair.target,
             h.kind.name(),
@@ -146,7 +146,6 @@ fn one_pair(
             e.orientation.map_or("null".to_string(), |o| format!("{o:.5}")),
             e.cost(),
             e.residual,
-            e.descriptor,
             s.error.mean,
             s.best_mean(),
             verdict.confidence,

@@ -30,18 +30,31 @@ pub struct PairResult {
     pub timings: Timings,
 }
 
-/// Runs the pairs of `pairs_file` (the dataset `root/NAME` of `pairs/NAME.txt`) on the shapes
-/// under `root`. Each shape's eigenbasis is computed once and reused; the time of a pair
-/// counts both eigenbases as if computed for it. `report` is called after every pair.
+/// Runs the pairs of `pairs_file` (the dataset `root/NAME` of `pairs/NAME.txt`, or a dataset
+/// name) on the shapes under `root`. Each shape's eigenbasis is computed once and reused (and
+/// kept in `cache`); the time of a pair counts both eigenbases as if computed for it.
+/// `report` is called after every pair.
 pub fn bench_regions(
     root: &Path,
     pairs_file: &Path,
     params: &Params,
     limit: Option<usize>,
+    cache: BasisCache,
     report: &mut dyn FnMut(usize, usize, &PairResult),
 ) -> Result<Vec<PairResult>> {
     let (dataset, pairs) = pair_list(root, pairs_file, limit)?;
-    let mut store = ShapeStore::new(dataset, params.eigen.clone(), BasisCache::default());
+    // With a cache, the bases are those of the pointwise maps (100 eigenpairs, cut to the
+    // regions' 50 for each pair), so that `bench p2p` and `bench regions` share them.
+    let eigen = match cache.dir {
+        Some(_) => shapecorr::EigenParams {
+            n_eigenpairs: shapecorr::PointwiseParams::default()
+                .n_eigenpairs
+                .max(params.eigen.n_eigenpairs),
+            ..params.eigen.clone()
+        },
+        None => params.eigen.clone(),
+    };
+    let mut store = ShapeStore::new(dataset, eigen, cache);
     let mut results = Vec::with_capacity(pairs.len());
     for (index, pair) in pairs.iter().enumerate() {
         let outcome = region_pair(&mut store, pair, params, &|a, ba, b, bb, p| {

@@ -30,6 +30,11 @@ pub enum BenchCommand {
     /// vertex of the target, the 0-based index of its vertex on the source), with the same
     /// geodesic error as `bench p2p`.
     Maps(BenchMapsArgs),
+    /// Every pair of every dataset with the default pipeline, judged by its tails: per
+    /// dataset the mean, median, worst pair and failed pairs of the map error and the region
+    /// accuracies, and how well the confidence flags the failed pairs. Writes OUT (default
+    /// docs/tails.md); resumable from WORK/tails.jsonl, eigenbases kept in WORK/eigenbases.
+    Tails(BenchTailsArgs),
 }
 
 impl BenchCommand {
@@ -39,6 +44,7 @@ impl BenchCommand {
             BenchCommand::P2p(args) => args.run(),
             BenchCommand::All(args) => args.run(),
             BenchCommand::Maps(args) => args.run(),
+            BenchCommand::Tails(args) => args.run(),
         }
     }
 }
@@ -62,6 +68,10 @@ pub struct BenchRegionsArgs {
     /// Only the first N pairs.
     #[arg(long)]
     limit: Option<usize>,
+    /// Keep the eigenbases in this folder and read them back on the next run (the same
+    /// cache as `bench p2p --basis-cache`: 100 eigenpairs, cut to the regions' own).
+    #[arg(long)]
+    basis_cache: Option<PathBuf>,
     #[command(flatten)]
     options: RegionOptions,
 }
@@ -75,6 +85,9 @@ impl BenchRegionsArgs {
             &self.pairs,
             &params,
             self.limit,
+            shapecorr_eval::bench_store::BasisCache {
+                dir: self.basis_cache.clone(),
+            },
             &mut |i, n, r| {
                 eprintln!(
                     "[{}/{}] {} -> {} ({}): symmetric {:.3}, one-to-one {:.3}{}, regions {}/{}, coverage {:.3}, k {}, {:.2} s",
@@ -371,4 +384,42 @@ fn write_scores_json(path: &Path, results: &[PairScores]) -> Result<(), Error> {
         path,
         &json!({ "version": env!("CARGO_PKG_VERSION"), "pairs": pairs }),
     )
+}
+
+#[derive(clap::Args)]
+pub struct BenchTailsArgs {
+    /// Dataset root (default: $SHAPECORR_DATA or ../shared/data).
+    #[arg(long)]
+    data: Option<PathBuf>,
+    /// The page to write.
+    #[arg(long, default_value = "docs/tails.md")]
+    out: PathBuf,
+    /// Log and eigenbasis cache.
+    #[arg(long, default_value = "target/bench-tails")]
+    work: PathBuf,
+    /// Only these datasets (comma separated).
+    #[arg(long, value_delimiter = ',')]
+    datasets: Option<Vec<String>>,
+    /// Ground-truth pairs scored per shape pair (a seeded sample; 0 = all).
+    #[arg(long, default_value_t = 1000)]
+    samples: usize,
+}
+
+impl BenchTailsArgs {
+    pub fn run(&self) -> Result<(), Error> {
+        let records = shapecorr_eval::bench_tails::run_tails(
+            &data_root(&self.data),
+            &self.work,
+            self.datasets.as_deref(),
+            self.samples,
+        )?;
+        let mut command = "shapecorr bench tails".to_string();
+        if let Some(d) = &self.datasets {
+            command.push_str(&format!(" --datasets {}", d.join(",")));
+        }
+        let page = shapecorr_eval::bench_tails::tails_page(&records, &command);
+        std::fs::write(&self.out, &page).map_err(|e| Error::file(&self.out, e.to_string()))?;
+        print!("{page}");
+        Ok(())
+    }
 }
