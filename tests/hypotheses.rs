@@ -6,7 +6,7 @@
 use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
 use shapecorr::geodesic::HeatGeodesics;
-use shapecorr::maps::pointwise::{truncated, verify_regions, PointwiseMap, PointwiseParams};
+use shapecorr::maps::pointwise::{PointwiseMap, PointwiseParams};
 use shapecorr::synth::{self, FigureKind, FigureMesh, Proportions};
 use shapecorr::{EigenParams, Eigenbasis, NoProgress, Shape};
 
@@ -34,25 +34,20 @@ fn basis(shape: &Shape) -> Eigenbasis {
     .unwrap()
 }
 
-/// Regions on the first 50 eigenpairs (verified unless `params` says otherwise), then the
-/// default map on all 100.
+/// The pipeline's regions and map ([`shapecorr::maps::pointwise::regions_and_map`]).
 fn regions_and_map(
     (a, basis_a): (&Shape, &Eigenbasis),
     (b, basis_b): (&Shape, &Eigenbasis),
     params: &Params,
 ) -> (Correspondence, PointwiseMap) {
-    let k = params.eigen.n_eigenpairs;
-    let regions = Correspondence::from_bases(
-        a,
-        &truncated(basis_a, k),
-        b,
-        &truncated(basis_b, k),
+    shapecorr::maps::pointwise::regions_and_map(
+        (a, basis_a),
+        (b, basis_b),
         params,
+        &PointwiseParams::default(),
         &mut NoProgress,
     )
-    .unwrap();
-    let map = map_of(a, basis_a, b, basis_b, &regions);
-    (regions, map)
+    .unwrap()
 }
 
 fn map_of(
@@ -104,15 +99,12 @@ fn a_forced_mirror_image_answer_gives_the_same_map() {
     let (basis_a, basis_b) = (basis(&a), basis(&b));
     let (regions, map) = regions_and_map((&a, &basis_a), (&b, &basis_b), &Params::default());
     let unforced = error(&a, basis_a.input_area, b.n_vertices(), &map.p2p_ba, &|v| v);
-    // The same regions with the one-to-one answer forced to its mirror image, verified as
-    // the pipeline verifies any answer.
+    // The same regions with the one-to-one answer forced to its mirror image: the map
+    // verifies it as it verifies any answer.
     let mut forced = regions.clone();
     forced.matches_one_to_one = mirrored_answer(&regions, &mirror);
     forced.verdict = None;
     assert_ne!(forced.matches_one_to_one, regions.matches_one_to_one);
-    let k = Params::default().eigen.n_eigenpairs;
-    let (small_a, small_b) = (truncated(&basis_a, k), truncated(&basis_b, k));
-    verify_regions((&a, &small_a), (&b, &small_b), &mut forced).unwrap();
     let forced_map = map_of(&a, &basis_a, &b, &basis_b, &forced);
     let after = error(
         &a,

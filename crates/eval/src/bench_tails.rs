@@ -15,9 +15,9 @@ use crate::bench_pointwise::score_maps;
 use crate::bench_store::{BasisCache, ResultLog, ShapeStore};
 use crate::datasets::{discover, Pair};
 use crate::tails::{error_tails_table, Tails, FAILED_ERRORS};
-use shapecorr::correspondence::{Correspondence, Params};
+use shapecorr::correspondence::Params;
 use shapecorr::evaluation::score_correspondence;
-use shapecorr::maps::pointwise::{truncated, PointwiseMap, PointwiseParams};
+use shapecorr::maps::pointwise::{regions_and_map, PointwiseParams};
 use shapecorr::progress::NoProgress;
 use shapecorr::spectral::eigen::EigenParams;
 use shapecorr::Result;
@@ -116,16 +116,13 @@ fn tail_pair(
         &store.basis(&pair.target).basis,
     );
     let t = Instant::now();
-    let k = params.eigen.n_eigenpairs;
-    let regions = Correspondence::from_bases(
-        a,
-        &truncated(basis_a, k),
-        b,
-        &truncated(basis_b, k),
+    let (regions, map) = regions_and_map(
+        (a, basis_a),
+        (b, basis_b),
         params,
+        pointwise,
         &mut NoProgress,
     )?;
-    let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(&regions), pointwise)?;
     let seconds = t.elapsed().as_secs_f64();
     let (truth, flipped) =
         store

@@ -185,7 +185,7 @@ impl BenchP2pArgs {
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_table(&results)
         );
-        println!("\nTails (mean error per pair, flip allowed where a mirror map exists):\n");
+        println!("\nTails (mean error per pair against the ground truth, no flip):\n");
         print!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_tails_table(&results)
@@ -328,7 +328,7 @@ impl BenchMapsArgs {
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_table(&results)
         );
-        println!("\nTails (mean error per pair, flip allowed where a mirror map exists):\n");
+        println!("\nTails (mean error per pair against the ground truth, no flip):\n");
         print!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_tails_table(&results)
