@@ -66,6 +66,11 @@
 // empty when the option `one_to_one` is false).
 #define SC_MATCHES_ONE_TO_ONE 1
 
+// Below this confidence (`sc_correspondence_confidence`, `sc_pointwise_confidence`) an
+// answer is doubtful and has a warning (`sc_correspondence_warning`,
+// `sc_pointwise_warning`).
+#define SC_CONFIDENCE_DOUBTFUL_BELOW 0.5
+
 // An integer option (`sc_params_set_int`).
 #define SC_OPTION_INT 0
 
@@ -332,6 +337,28 @@ sc_status sc_correspondence_seconds(const sc_correspondence *correspondence,
                                     const char *stage,
                                     double *out_seconds);
 
+// The confidence of the one-to-one answer, in [0, 1]: high when the chosen region
+// hypothesis gives a consistent map clearly better than the runner-up's (below
+// `SC_CONFIDENCE_DOUBTFUL_BELOW` the answer is doubtful, see `sc_correspondence_warning`).
+// NaN when there is none: the answer was not verified (option `verify_hypotheses` or
+// `one_to_one` false, or a single hypothesis, so nothing to choose from), and for NULL.
+// Test it with `isnan`.
+//
+// # Safety
+// `correspondence` must be NULL or live.
+double sc_correspondence_confidence(const sc_correspondence *correspondence);
+
+// What to tell the user when the answer is doubtful (confidence below
+// `SC_CONFIDENCE_DOUBTFUL_BELOW`): one sentence, UTF-8, saying whether another region
+// hypothesis came close (parts may be swapped or mirrored) or the best map found is itself
+// poor. NULL when the answer is not doubtful, when it has no confidence
+// (`sc_correspondence_confidence` is NaN), and for NULL. The string belongs to
+// `correspondence`: valid until it is freed; never free it.
+//
+// # Safety
+// `correspondence` must be NULL or live.
+const char *sc_correspondence_warning(const sc_correspondence *correspondence);
+
 // New parameters with the documented defaults.
 //
 // # Safety
@@ -485,6 +512,25 @@ sc_status sc_pointwise_regions(const sc_pointwise *pointwise,
 sc_status sc_pointwise_seconds(const sc_pointwise *pointwise,
                                const char *stage,
                                double *out_seconds);
+
+// The confidence of the answer, in [0, 1]: that of the pointwise map's own choice among
+// region hypotheses when it verified several (options `p2p_orientation`,
+// `p2p_hypotheses`), else that of the region correspondence it was built on (as
+// `sc_correspondence_confidence`). Below `SC_CONFIDENCE_DOUBTFUL_BELOW` the answer is
+// doubtful (see `sc_pointwise_warning`). NaN when there is none (nothing was verified) and for NULL.
+//
+// # Safety
+// `pointwise` must be NULL or live.
+double sc_pointwise_confidence(const sc_pointwise *pointwise);
+
+// What to tell the user when the answer is doubtful (as `sc_correspondence_warning`, for
+// the verdict behind `sc_pointwise_confidence`): NULL when it is not doubtful, when there
+// is no confidence, and for NULL. The string belongs to `pointwise`: valid until it is
+// freed; never free it.
+//
+// # Safety
+// `pointwise` must be NULL or live.
+const char *sc_pointwise_warning(const sc_pointwise *pointwise);
 
 // A triangle mesh from `n_vertices` points `xyz = x0 y0 z0 x1 y1 z1 ...` (doubles, packed,
 // 3 per vertex) and `n_triangles` triangles `triangles = a0 b0 c0 a1 ...` (0-based vertex

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -116,6 +117,16 @@ class Correspondence {
         std::vector<std::uint8_t> out(4 * sc_correspondence_n_vertices(ptr_.get(), side));
         check(sc_correspondence_colors(ptr_.get(), side, kind, out.data(), out.size()));
         return out;
+    }
+    // The confidence of the one-to-one answer in [0, 1]; NaN when it was not verified.
+    double confidence() const { return sc_correspondence_confidence(ptr_.get()); }
+    // What to tell the user when the answer is doubtful (confidence below
+    // SC_CONFIDENCE_DOUBTFUL_BELOW); nothing otherwise.
+    std::optional<std::string> warning() const {
+        const char *text = sc_correspondence_warning(ptr_.get());
+        if (text == nullptr)
+            return std::nullopt;
+        return std::string(text);
     }
     const sc_correspondence *get() const noexcept { return ptr_.get(); }
 

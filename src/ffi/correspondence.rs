@@ -1,6 +1,6 @@
 //! Region correspondence between two shapes: `sc_match` and the result's accessors.
 
-use std::ffi::{c_char, c_void};
+use std::ffi::{c_char, c_void, CStr, CString};
 
 use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
@@ -10,12 +10,35 @@ use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
 use crate::correspondence::Correspondence;
+use crate::maps::hypotheses::Verdict;
 use crate::regions::graph::ShapeGraph;
 
 /// The result of `sc_match`. Immutable: one handle may be read from several threads at
 /// once. Free it with `sc_correspondence_free`.
 pub struct ScCorrespondence {
     pub(crate) result: Correspondence,
+    /// The verdict's warning, made once with the handle: what `sc_correspondence_warning`
+    /// points into.
+    warning: Option<CString>,
+}
+
+impl ScCorrespondence {
+    pub(crate) fn new(result: Correspondence) -> Self {
+        let warning = warning_text(result.verdict.as_ref());
+        ScCorrespondence { result, warning }
+    }
+}
+
+/// A verdict's warning ([`Verdict::warning`]) as a C string: None when there is no verdict
+/// or the answer is not doubtful.
+pub(crate) fn warning_text(verdict: Option<&Verdict>) -> Option<CString> {
+    let text = verdict?.warning()?;
+    CString::new(text.replace('\0', " ")).ok()
+}
+
+/// The pointer a `_warning` accessor returns: the handle's own string, or NULL.
+pub(crate) fn warning_ptr(warning: &Option<CString>) -> *const c_char {
+    warning.as_deref().map_or(std::ptr::null(), CStr::as_ptr)
 }
 
 /// Side A: the first shape given to `sc_match`.
@@ -28,6 +51,10 @@ pub const SC_MATCHES_SYMMETRIC: u32 = 0;
 /// The one-to-one region matches after symmetry breaking (a subset of the symmetric ones;
 /// empty when the option `one_to_one` is false).
 pub const SC_MATCHES_ONE_TO_ONE: u32 = 1;
+/// Below this confidence (`sc_correspondence_confidence`, `sc_pointwise_confidence`) an
+/// answer is doubtful and has a warning (`sc_correspondence_warning`,
+/// `sc_pointwise_warning`).
+pub const SC_CONFIDENCE_DOUBTFUL_BELOW: f64 = 0.5;
 
 /// Region correspondence between shapes `a` and `b` (meshes, point clouds or one of each):
 /// eigenbases, heat kernel signatures, joint segmentation over the range of k, spectral
@@ -62,7 +89,7 @@ pub unsafe extern "C" fn sc_match(
             userdata,
         };
         let result = Correspondence::compute(a, b, &params, &mut progress)?;
-        give_handle(out_correspondence, ScCorrespondence { result })
+        give_handle(out_correspondence, ScCorrespondence::new(result))
     })
 }
 
@@ -345,4 +372,137 @@ pub unsafe extern "C" fn sc_correspondence_seconds(
         };
         Ok(())
     })
+}
+
+/// The confidence of the one-to-one answer, in [0, 1]: high when the chosen region
+/// hypothesis gives a consistent map clearly better than the runner-up's (below
+/// `SC_CONFIDENCE_DOUBTFUL_BELOW` the answer is doubtful, see `sc_correspondence_warning`).
+/// NaN when there is none: the answer was not verified (option `verify_hypotheses` or
+/// `one_to_one` false, or a single hypothesis, so nothing to choose from), and for NULL.
+/// Test it with `isnan`.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_confidence(
+    correspondence: *const ScCorrespondence,
+) -> f64 {
+    boundary_value(f64::NAN, || {
+        let c = handle(correspondence, "correspondence")?;
+        Ok(c.result.confidence().unwrap_or(f64::NAN))
+    })
+}
+
+/// What to tell the user when the answer is doubtful (confidence below
+/// `SC_CONFIDENCE_DOUBTFUL_BELOW`): one sentence, UTF-8, saying whether another region
+/// hypothesis came close (parts may be swapped or mirrored) or the best map found is itself
+/// poor. NULL when the answer is not doubtful, when it has no confidence
+/// (`sc_correspondence_confidence` is NaN), and for NULL. The string belongs to
+/// `correspondence`: valid until it is freed; never free it.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_warning(
+    correspondence: *const ScCorrespondence,
+) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        Ok(warning_ptr(
+            &handle(correspondence, "correspondence")?.warning,
+        ))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::correspondence::Timings;
+    use crate::maps::hypotheses::{HypothesisKind, HypothesisScore, MapEnergy, DOUBTFUL_BELOW};
+
+    #[test]
+    fn header_threshold_matches_the_verdicts() {
+        assert_eq!(SC_CONFIDENCE_DOUBTFUL_BELOW, DOUBTFUL_BELOW);
+    }
+
+    fn empty_graph() -> ShapeGraph {
+        ShapeGraph {
+            labels: Vec::new(),
+            node_cluster: Vec::new(),
+            node_area: Vec::new(),
+            node_descriptor: Vec::new(),
+            edges: Vec::new(),
+        }
+    }
+
+    fn score(kind: HypothesisKind, distortion: f64, distance_to_chosen: f64) -> HypothesisScore {
+        HypothesisScore {
+            kind,
+            energy: MapEnergy {
+                distortion,
+                coverage: 1.0,
+                orientation: Some(1.0),
+                residual: 0.1,
+                descriptor: 0.1,
+            },
+            fmap_ab: faer::Mat::zeros(2, 2),
+            distance_to_chosen,
+        }
+    }
+
+    fn with_verdict(confidence: Option<f64>) -> ScCorrespondence {
+        ScCorrespondence::new(Correspondence {
+            k: 5,
+            graph_a: empty_graph(),
+            graph_b: empty_graph(),
+            matches: Vec::new(),
+            matches_one_to_one: Vec::new(),
+            candidates: Vec::new(),
+            timings: Timings::default(),
+            verdict: confidence.map(|confidence| Verdict {
+                chosen: 0,
+                scores: vec![
+                    score(HypothesisKind::Answer, 0.05, 0.0),
+                    score(HypothesisKind::Mirror, 0.051, 0.3),
+                ],
+                confidence,
+            }),
+        })
+    }
+
+    #[test]
+    fn confidence_and_warning_follow_the_verdict() {
+        let none = with_verdict(None);
+        let sure = with_verdict(Some(0.9));
+        let doubtful = with_verdict(Some(0.2));
+        unsafe {
+            assert!(sc_correspondence_confidence(&none).is_nan());
+            assert!(sc_correspondence_warning(&none).is_null());
+            assert_eq!(sc_correspondence_confidence(&sure), 0.9);
+            assert!(sc_correspondence_warning(&sure).is_null());
+            assert_eq!(sc_correspondence_confidence(&doubtful), 0.2);
+            let text = sc_correspondence_warning(&doubtful);
+            assert!(!text.is_null());
+            let text = CStr::from_ptr(text).to_str().unwrap();
+            assert_eq!(
+                Some(text.to_string()),
+                doubtful.result.verdict.as_ref().unwrap().warning()
+            );
+            assert!(text.contains("mirror"), "{text}");
+            // The same pointer every time: the handle owns the string.
+            assert_eq!(
+                sc_correspondence_warning(&doubtful),
+                sc_correspondence_warning(&doubtful)
+            );
+        }
+    }
+
+    #[test]
+    fn null_handles_have_no_confidence_and_no_warning() {
+        unsafe {
+            assert!(sc_correspondence_confidence(std::ptr::null()).is_nan());
+            assert!(sc_correspondence_warning(std::ptr::null()).is_null());
+            let message = CStr::from_ptr(super::super::sc_last_error());
+            assert!(message.to_str().unwrap().contains("correspondence"));
+        }
+    }
 }

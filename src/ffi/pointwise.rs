@@ -1,12 +1,12 @@
 //! Point-to-point maps between two shapes: `sc_pointwise_map` and the result's accessors.
 
-use std::ffi::{c_char, c_void};
+use std::ffi::{c_char, c_void, CString};
 
 use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
     Failure, FfiResult, ScStatus,
 };
-use super::correspondence::{ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
+use super::correspondence::{warning_ptr, warning_text, ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
@@ -17,6 +17,9 @@ use crate::maps::pointwise::PointwiseCorrespondence;
 /// several threads at once. Free it with `sc_pointwise_free`.
 pub struct ScPointwise {
     pub(crate) result: PointwiseCorrespondence,
+    /// The verdict's warning, made once with the handle: what `sc_pointwise_warning` points
+    /// into.
+    warning: Option<CString>,
 }
 
 /// Option `p2p_regions`: no region constraint (then `p2p_wks` must be true).
@@ -72,7 +75,8 @@ pub unsafe extern "C" fn sc_pointwise_map(
             options.pointwise(),
             &mut progress,
         )?;
-        give_handle(out_pointwise, ScPointwise { result })
+        let warning = warning_text(result.verdict());
+        give_handle(out_pointwise, ScPointwise { result, warning })
     })
 }
 
@@ -184,9 +188,7 @@ pub unsafe extern "C" fn sc_pointwise_regions(
         let p = handle(pointwise, "pointwise")?;
         give_handle(
             out_correspondence,
-            ScCorrespondence {
-                result: p.result.regions.clone(),
-            },
+            ScCorrespondence::new(p.result.regions.clone()),
         )
     })
 }
@@ -228,6 +230,36 @@ pub unsafe extern "C" fn sc_pointwise_seconds(
     })
 }
 
+/// The confidence of the answer, in [0, 1]: that of the pointwise map's own choice among
+/// region hypotheses when it verified several (options `p2p_orientation`,
+/// `p2p_hypotheses`), else that of the region correspondence it was built on (as
+/// `sc_correspondence_confidence`). Below `SC_CONFIDENCE_DOUBTFUL_BELOW` the answer is
+/// doubtful (see `sc_pointwise_warning`). NaN when there is none (nothing was verified) and for NULL.
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_confidence(pointwise: *const ScPointwise) -> f64 {
+    boundary_value(f64::NAN, || {
+        let p = handle(pointwise, "pointwise")?;
+        Ok(p.result.confidence().unwrap_or(f64::NAN))
+    })
+}
+
+/// What to tell the user when the answer is doubtful (as `sc_correspondence_warning`, for
+/// the verdict behind `sc_pointwise_confidence`): NULL when it is not doubtful, when there
+/// is no confidence, and for NULL. The string belongs to `pointwise`: valid until it is
+/// freed; never free it.
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_warning(pointwise: *const ScPointwise) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        Ok(warning_ptr(&handle(pointwise, "pointwise")?.warning))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,5 +285,13 @@ mod tests {
         assert_eq!(SC_P2P_REFINEMENT_NONE, P2P_REFINEMENT_NONE);
         assert_eq!(SC_P2P_REFINEMENT_ZOOMOUT, P2P_REFINEMENT_ZOOMOUT);
         assert_eq!(SC_P2P_REFINEMENT_ICP, P2P_REFINEMENT_ICP);
+    }
+
+    #[test]
+    fn null_handles_have_no_confidence_and_no_warning() {
+        unsafe {
+            assert!(sc_pointwise_confidence(std::ptr::null()).is_nan());
+            assert!(sc_pointwise_warning(std::ptr::null()).is_null());
+        }
     }
 }

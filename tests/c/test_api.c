@@ -1,9 +1,11 @@
 /*
  * C API tests: the whole life cycle on generated figures, every error path, cancellation,
- * concurrent calls on shared handles, the version check, and the point-to-point map (a
- * permuted copy of a figure is mapped back to the identity). Compiled as C99 with
- * -Wall -Wextra -Wpedantic -Werror against include/shapecorr.h and linked against the
- * built libshapecorr.so by tests/c/run.sh (plain, under ASan+UBSan, and under valgrind).
+ * concurrent calls on shared handles, the version check, the confidence and warning of a
+ * result (in range, a warning exactly when doubtful, none unverified or for NULL), and the
+ * point-to-point map (a permuted copy of a figure is mapped back to the identity).
+ * Compiled as C99 with -Wall -Wextra -Wpedantic -Werror against include/shapecorr.h and
+ * linked against the built libshapecorr.so by tests/c/run.sh (plain, under ASan+UBSan, and
+ * under valgrind).
  *
  * SHAPECORR_TEST_QUICK=1 (used under valgrind) makes the figures smaller and the thread
  * test shorter; the checks are the same.
@@ -259,6 +261,19 @@ static double region_accuracy(const sc_correspondence *c, uint32_t kind) {
     return (double)good / (double)n;
 }
 
+/* A confidence is in [0, 1] or NaN (none); the warning is NULL or a non-empty sentence, and
+ * it is there exactly when the confidence is below SC_CONFIDENCE_DOUBTFUL_BELOW. */
+static void check_confidence(const char *what, double confidence, const char *warning) {
+    bool doubtful = !isnan(confidence) && confidence < SC_CONFIDENCE_DOUBTFUL_BELOW;
+    CHECK(isnan(confidence) || (confidence >= 0.0 && confidence <= 1.0), "%s: confidence %g",
+          what, confidence);
+    CHECK(warning == NULL || strlen(warning) > 0, "%s: empty warning", what);
+    CHECK((warning != NULL) == doubtful, "%s: confidence %g, warning %s", what, confidence,
+          warning != NULL ? warning : "(NULL)");
+    printf("%s: confidence %g%s%s\n", what, confidence, warning != NULL ? "; " : "",
+           warning != NULL ? warning : "");
+}
+
 static void test_life_cycle(void) {
     sc_shape *a = figure("humanoid", 0), *b_mesh = figure("humanoid", 3), *b = NULL;
     sc_params *params = NULL;
@@ -308,6 +323,9 @@ static void test_life_cycle(void) {
            "%.3f, one-to-one %.3f\n",
            sc_shape_n_vertices(a), nv, sc_correspondence_k(c), na, nb, sym, one);
     CHECK(sym >= (quick ? 0.7 : 0.9), "symmetric accuracy %.3f", sym);
+    check_confidence("life cycle", sc_correspondence_confidence(c), sc_correspondence_warning(c));
+    CHECK(sc_correspondence_warning(c) == sc_correspondence_warning(c),
+          "the warning is the handle's own string");
     CHECK(sc_correspondence_n_matches(c, SC_MATCHES_ONE_TO_ONE) <=
               sc_correspondence_n_matches(c, SC_MATCHES_SYMMETRIC),
           "one-to-one is a subset");
@@ -383,6 +401,9 @@ static void test_life_cycle(void) {
 done:
     sc_correspondence_free(c);
     sc_correspondence_free(NULL);
+    /* NULL: no confidence, no warning, as the other getters give 0. */
+    CHECK(isnan(sc_correspondence_confidence(NULL)), "NULL has no confidence");
+    CHECK(sc_correspondence_warning(NULL) == NULL, "NULL has no warning");
     sc_params_free(params);
     sc_shape_free(a);
     sc_shape_free(b);
@@ -420,6 +441,31 @@ static void test_point_cloud(void) {
     sc_shape_free(mesh);
     sc_shape_free(cloud);
     free(xyz);
+}
+
+/* Without the verification of hypotheses (or without the one-to-one step) there is no
+ * confidence: NaN, and no warning. */
+static void test_unverified_has_no_confidence(void) {
+    sc_shape *a = figure("star4", 0), *b = figure("star4", 2);
+    sc_params *params = NULL;
+    sc_correspondence *c = NULL;
+    bool verify = false;
+    if (a == NULL || b == NULL)
+        return;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_get_bool(params, "verify_hypotheses", &verify), SC_STATUS_OK);
+    CHECK(verify, "verify_hypotheses is on by default");
+    CHECK_STATUS(sc_params_set_bool(params, "verify_hypotheses", false), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, b, params, NULL, NULL, &c), SC_STATUS_OK);
+    if (c != NULL) {
+        CHECK(isnan(sc_correspondence_confidence(c)), "confidence %g without verification",
+              sc_correspondence_confidence(c));
+        CHECK(sc_correspondence_warning(c) == NULL, "no warning without verification");
+    }
+    sc_correspondence_free(c);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
 }
 
 static void test_match_errors(void) {
@@ -618,6 +664,8 @@ static void test_pointwise_errors(void) {
     CHECK_STATUS(sc_pointwise_fmap(NULL, NULL, 0), SC_STATUS_NULL_ARGUMENT);
     CHECK_STATUS(sc_pointwise_regions(NULL, NULL), SC_STATUS_NULL_ARGUMENT);
     CHECK_STATUS(sc_pointwise_seconds(NULL, "total", &t0), SC_STATUS_NULL_ARGUMENT);
+    CHECK(isnan(sc_pointwise_confidence(NULL)), "NULL has no confidence");
+    CHECK(sc_pointwise_warning(NULL) == NULL, "NULL has no warning");
     sc_pointwise_free(NULL);
     sc_shape_free(a);
 }
@@ -738,6 +786,11 @@ static void test_pointwise_permuted_copy(void) {
     CHECK(sc_correspondence_n_vertices(regions, SC_SIDE_B) == n, "regions of B");
     CHECK(sc_correspondence_n_matches(regions, SC_MATCHES_ONE_TO_ONE) >= 5, "%zu matches",
           sc_correspondence_n_matches(regions, SC_MATCHES_ONE_TO_ONE));
+
+    /* Confidences: the map's answer and its regions', each in range with its warning. */
+    check_confidence("pointwise", sc_pointwise_confidence(p), sc_pointwise_warning(p));
+    check_confidence("pointwise regions", sc_correspondence_confidence(regions),
+                     sc_correspondence_warning(regions));
 
     CHECK_STATUS(sc_pointwise_seconds(p, "total", &total), SC_STATUS_OK);
     CHECK_STATUS(sc_pointwise_seconds(p, "eigenbasis_a", &seconds), SC_STATUS_OK);
@@ -872,6 +925,7 @@ int main(void) {
     test_match_errors();
     test_life_cycle();
     test_point_cloud();
+    test_unverified_has_no_confidence();
     test_cancellation();
     test_symmetry();
     test_pointwise_options();

@@ -1,5 +1,6 @@
 // The C header compiles as C++ (-Wall -Wextra -Wpedantic -Werror) and the RAII wrapper
 // works: a match through it, and an error that becomes a shapecorr::Error.
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 
@@ -27,6 +28,18 @@ int main() {
                     matches.size(), accuracy);
         if (c.k() < 5 || c.k() > 7 || accuracy < 0.85 || c.colors(SC_SIDE_B, SC_MATCHES_ONE_TO_ONE).size() != 4 * rb.size()) {
             std::printf("FAIL: unexpected result\n");
+            failures++;
+        }
+        // The confidence is in [0, 1] or NaN; a warning exactly when it is doubtful.
+        double confidence = c.confidence();
+        std::optional<std::string> warning = c.warning();
+        bool doubtful = !std::isnan(confidence) && confidence < SC_CONFIDENCE_DOUBTFUL_BELOW;
+        std::printf("C++ wrapper: confidence %g%s%s\n", confidence, warning ? "; " : "",
+                    warning ? warning->c_str() : "");
+        if (!(std::isnan(confidence) || (confidence >= 0.0 && confidence <= 1.0)) ||
+            warning.has_value() != doubtful || (warning && warning->empty())) {
+            std::printf("FAIL: confidence %g with warning %s\n", confidence,
+                        warning ? warning->c_str() : "(none)");
             failures++;
         }
     } catch (const shapecorr::Error &e) {
