@@ -9,6 +9,8 @@ A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
     result.regions_a            # region of every vertex of A (numpy uint32)
     result.matches_one_to_one   # (n, 2) array of (region of A, region of B)
     result.colors("a")          # (n_vertices, 4) RGBA bytes, matched regions share a colour
+    result.confidence           # in [0, 1], or None when the answer was not verified
+    result.warning              # a sentence when the answer is doubtful, else None
     pointwise = shapecorr.pointwise_map(a, b)
     pointwise.map_b_to_a        # vertex of A for every vertex of B (numpy uint32)
 
@@ -20,6 +22,7 @@ works (ctypes does).
 
 import ctypes
 import functools
+import math
 import weakref
 
 import numpy as np
@@ -38,6 +41,7 @@ __all__ = [
     "pointwise_map",
     "options",
     "version",
+    "CONFIDENCE_DOUBTFUL_BELOW",
 ]
 
 
@@ -56,6 +60,10 @@ def _check(status):
     if status != 0:
         message = lib.sc_last_error().decode("utf-8", "replace")
         raise ShapecorrError(status, message)
+
+
+#: Below this confidence an answer is doubtful and has a warning (``SC_CONFIDENCE_DOUBTFUL_BELOW``).
+CONFIDENCE_DOUBTFUL_BELOW = _lib.CONFIDENCE_DOUBTFUL_BELOW
 
 
 def version():
@@ -259,6 +267,16 @@ class _Progress:
         _check(status)
 
 
+def _confidence(value):
+    """A C confidence (NaN: none) as a float or None."""
+    return None if math.isnan(value) else float(value)
+
+
+def _warning(text):
+    """A C warning (NULL: none) as a str or None."""
+    return None if text is None else text.decode("utf-8", "replace")
+
+
 def _side(side):
     if side in ("a", "A", 0):
         return _lib.SIDE_A
@@ -335,6 +353,24 @@ class Correspondence(_Handle):
             ),
             "edges": _fill(lib.sc_correspondence_edges, self, s, shape=(e, 2), dtype=np.uint32, ctype=ctypes.c_uint32),
         }
+
+    @property
+    def confidence(self):
+        """The confidence of the one-to-one answer, a float in [0, 1] (below
+        ``CONFIDENCE_DOUBTFUL_BELOW``, 0.5, the answer is doubtful), or None when it was not
+        verified (``verify_hypotheses=False``, ``one_to_one=False``, or nothing to choose
+        from)."""
+        return _confidence(lib.sc_correspondence_confidence(self))
+
+    @property
+    def warning(self):
+        """What to tell the user when the answer is doubtful (one sentence), else None."""
+        return _warning(lib.sc_correspondence_warning(self))
+
+    @property
+    def doubtful(self):
+        """True when the answer has a confidence below ``CONFIDENCE_DOUBTFUL_BELOW``."""
+        return self.warning is not None
 
     @property
     def timings(self):
@@ -431,6 +467,23 @@ class PointwiseMap(_Handle):
         coefficients in A's Laplacian eigenbasis to the transported function's on B."""
         rows, cols = lib.sc_pointwise_fmap_rows(self), lib.sc_pointwise_fmap_cols(self)
         return _fill(lib.sc_pointwise_fmap, self, shape=(rows, cols), dtype=np.float64, ctype=ctypes.c_double)
+
+    @property
+    def confidence(self):
+        """The confidence of the answer, a float in [0, 1]: of the map's own choice among
+        region hypotheses when it verified several (``p2p_orientation``,
+        ``p2p_hypotheses``), else of its :attr:`regions`; None when nothing was verified."""
+        return _confidence(lib.sc_pointwise_confidence(self))
+
+    @property
+    def warning(self):
+        """What to tell the user when the answer is doubtful (one sentence), else None."""
+        return _warning(lib.sc_pointwise_warning(self))
+
+    @property
+    def doubtful(self):
+        """True when the answer has a confidence below ``CONFIDENCE_DOUBTFUL_BELOW``."""
+        return self.warning is not None
 
     @functools.cached_property
     def regions(self):

@@ -121,6 +121,8 @@ FUNCTIONS = {
     "sc_correspondence_n_edges": (c_size_t, [handle, c_u32]),
     "sc_correspondence_edges": (status, [handle, c_u32, c_u32p, c_size_t]),
     "sc_correspondence_seconds": (status, [handle, c_str, c_f64p]),
+    "sc_correspondence_confidence": (ctypes.c_double, [handle]),
+    "sc_correspondence_warning": (c_str, [handle]),
     # symmetry
     "sc_symmetry_detect": (status, [handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_symmetry_free": (None, [handle]),
@@ -140,6 +142,8 @@ FUNCTIONS = {
     "sc_pointwise_fmap": (status, [handle, c_f64p, c_size_t]),
     "sc_pointwise_regions": (status, [handle, handle_out]),
     "sc_pointwise_seconds": (status, [handle, c_str, c_f64p]),
+    "sc_pointwise_confidence": (ctypes.c_double, [handle]),
+    "sc_pointwise_warning": (c_str, [handle]),
 }
 
 for _name, (_restype, _argtypes) in FUNCTIONS.items():
@@ -159,6 +163,8 @@ MATCHES_SYMMETRIC, MATCHES_ONE_TO_ONE = 0, 1
 OPTION_INT, OPTION_DOUBLE, OPTION_BOOL = 0, 1, 2
 P2P_REGIONS_NONE, P2P_REGIONS_ONE_TO_ONE, P2P_REGIONS_SYMMETRIC = 0, 1, 2
 P2P_REFINEMENT_NONE, P2P_REFINEMENT_ZOOMOUT, P2P_REFINEMENT_ICP = 0, 1, 2
+#: Below this confidence an answer is doubtful and has a warning.
+CONFIDENCE_DOUBTFUL_BELOW = 0.5
 STATUS_NAMES = {
     0: "OK",
     1: "NULL_ARGUMENT",

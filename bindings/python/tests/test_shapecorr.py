@@ -64,6 +64,24 @@ def test_every_header_function_is_declared_and_nothing_else():
     assert functions == set(_lib.FUNCTIONS)
 
 
+def test_doubtful_threshold_matches_the_header():
+    header = (REPOSITORY / "include" / "shapecorr.h").read_text()
+    value = re.search(r"#define SC_CONFIDENCE_DOUBTFUL_BELOW ([0-9.]+)", header)
+    assert value and float(value.group(1)) == shapecorr.CONFIDENCE_DOUBTFUL_BELOW
+
+
+def check_confidence(result):
+    """``confidence`` is a float in [0, 1] or None; ``warning`` a non-empty str exactly when
+    the answer is doubtful, else None."""
+    confidence, warning = result.confidence, result.warning
+    assert confidence is None or (isinstance(confidence, float) and 0.0 <= confidence <= 1.0), confidence
+    assert warning is None or (isinstance(warning, str) and warning), warning
+    doubtful = confidence is not None and confidence < shapecorr.CONFIDENCE_DOUBTFUL_BELOW
+    assert (warning is not None) == doubtful == result.doubtful, (confidence, warning)
+    if warning is not None:
+        assert "doubtful" in warning and f"{confidence:.2f}" in warning, warning
+
+
 def test_status_names_match_the_header():
     header = (REPOSITORY / "include" / "shapecorr.h").read_text()
     in_header = {int(v): n for n, v in re.findall(r"SC_STATUS_([A-Z_]+) = (\d+)", header)}
@@ -234,6 +252,21 @@ def test_life_cycle(humanoids):
     assert np.all(graph["edges"][:, 0] < graph["edges"][:, 1])
     timings = result.timings
     assert 0 < timings["eigenbasis_a"] <= timings["total"]
+    check_confidence(result)
+    assert result.confidence is not None, "verified by default"
+
+
+def test_no_confidence_without_verification():
+    a, b = shapecorr.Shape.figure("star4", 0, 1500), shapecorr.Shape.figure("star4", 2, 1500)
+    for options in (dict(verify_hypotheses=False), dict(one_to_one=False)):
+        result = shapecorr.match(a, b, **options)
+        assert result.confidence is None and result.warning is None, options
+        assert not result.doubtful
+    lib = _lib.lib
+    assert math.isnan(lib.sc_correspondence_confidence(None))
+    assert lib.sc_correspondence_warning(None) is None
+    assert math.isnan(lib.sc_pointwise_confidence(None))
+    assert lib.sc_pointwise_warning(None) is None
 
 
 def test_vertices_round_trip_and_float32_input(humanoids):
@@ -362,6 +395,9 @@ def test_permuted_copy_is_mapped_back(humanoids):
     assert set(timings) == {"eigenbasis_a", "eigenbasis_b", "regions", "fmap", "refinement", "total"}
     assert 0 < timings["eigenbasis_a"] <= timings["total"]
     assert "PointwiseMap" in repr(result)
+    check_confidence(result)
+    check_confidence(regions)
+    assert result.confidence is not None, "verified by default"
 
 
 @pytest.mark.parametrize(
