@@ -44,7 +44,9 @@ enum Command {
     Synth(SynthArgs),
     /// Region correspondence between two shapes: writes DIR/result.json and
     /// DIR/a_regions.ply, DIR/b_regions.ply (matched regions share a colour, unmatched ones
-    /// are dark grey).
+    /// are dark grey). result.json has the answer's confidence (in [0, 1]; null when not
+    /// verified) and the hypotheses it was chosen from; a doubtful answer is also warned
+    /// about on stderr.
     Match(MatchArgs),
     /// Symmetric regions of one shape (the shape matched to itself): DIR/result.json and a
     /// PLY coloured by symmetry group.
@@ -53,7 +55,7 @@ enum Command {
     /// DIR/map_b_to_a.txt (for every vertex of B, the 0-based index of its vertex on A),
     /// DIR/result.json (the regions as `match`, plus timings), DIR/a_colors.ply (A coloured
     /// by its normalised coordinates) and DIR/b_mapped.ply (B with A's colours carried over
-    /// by the map).
+    /// by the map). The confidence and warning as `match`'s, for the map's answer.
     P2p(P2pArgs),
     /// Benchmarks on the research datasets.
     Bench {

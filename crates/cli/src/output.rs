@@ -5,6 +5,7 @@ use std::path::Path;
 use serde_json::json;
 use shapecorr::colors::{coordinate_colors, region_colors};
 use shapecorr::correspondence::Correspondence;
+use shapecorr::maps::hypotheses::Verdict;
 use shapecorr::options::{OptionGroup, OptionValue, Options, OPTIONS};
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::regions::graph::ShapeGraph;
@@ -76,8 +77,9 @@ pub fn graph_json(graph: &ShapeGraph) -> serde_json::Value {
     })
 }
 
+/// What `result.json` records of a region correspondence, with [`set_verdict_json`]'s keys.
 pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> serde_json::Value {
-    json!({
+    let mut value = json!({
         "version": env!("CARGO_PKG_VERSION"),
         "n_vertices_a": a.n_vertices(),
         "n_vertices_b": b.n_vertices(),
@@ -93,7 +95,56 @@ pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> ser
         "timings_s": result.timings,
         "warnings_a": a.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
         "warnings_b": b.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
-    })
+    });
+    set_verdict_json(&mut value, result.verdict.as_ref());
+    value
+}
+
+/// Sets the keys of `result.json` that say how sure the answer is: `confidence` (in [0, 1],
+/// null when the answer was not verified), `doubtful`, `warning` (the verdict's sentence
+/// when doubtful, else null) and `hypotheses` (every hypothesis verified, with its map's
+/// energy and whether it was chosen; empty when not verified).
+pub fn set_verdict_json(value: &mut serde_json::Value, verdict: Option<&Verdict>) {
+    let hypotheses: Vec<serde_json::Value> = verdict
+        .map(|v| {
+            v.scores
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    json!({
+                        "kind": s.kind.name(),
+                        "chosen": i == v.chosen,
+                        "cost": s.energy.cost(),
+                        "distortion": s.energy.distortion,
+                        "coverage": s.energy.coverage,
+                        "orientation": s.energy.orientation,
+                        "residual": s.energy.residual,
+                    })
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    value["confidence"] = json!(verdict.map(|v| v.confidence));
+    value["doubtful"] = json!(verdict.is_some_and(Verdict::doubtful));
+    value["warning"] = json!(verdict.and_then(Verdict::warning));
+    value["hypotheses"] = json!(hypotheses);
+}
+
+/// How sure the answer is, for the one-line summary: `confidence 0.93`, `confidence 0.31,
+/// doubtful` or `not verified` (no confidence).
+pub fn confidence_summary(verdict: Option<&Verdict>) -> String {
+    match verdict {
+        Some(v) if v.doubtful() => format!("confidence {:.2}, doubtful", v.confidence),
+        Some(v) => format!("confidence {:.2}", v.confidence),
+        None => "not verified".to_string(),
+    }
+}
+
+/// Prints the verdict's warning on stderr, one line, when the answer is doubtful.
+pub fn print_warning(verdict: Option<&Verdict>) {
+    if let Some(warning) = verdict.and_then(Verdict::warning) {
+        eprintln!("shapecorr: warning: {}", warning.replace(['\n', '\r'], " "));
+    }
 }
 
 /// Writes the coloured PLYs of a correspondence; colours by the one-to-one matches when

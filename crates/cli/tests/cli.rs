@@ -36,6 +36,58 @@ fn synth_figure(kind: &str, pose: &str, vertices: &str, path: &Path) {
     );
 }
 
+/// The keys of `result.json` that say how sure the answer is: `confidence` a number in
+/// [0, 1] or null, `doubtful` a bool (true exactly below the threshold), `warning` a
+/// non-empty string exactly when doubtful, else null, `hypotheses` one entry per verified
+/// hypothesis (kind, chosen, cost, energies) with exactly one chosen, none when not
+/// verified; and stderr carries the warning on one line exactly when doubtful. Returns the
+/// confidence.
+fn check_verdict(result: &serde_json::Value, stderr: &str) -> Option<f64> {
+    let confidence = result["confidence"].as_f64();
+    assert!(
+        confidence.is_some() || result["confidence"].is_null(),
+        "{}",
+        result["confidence"]
+    );
+    if let Some(c) = confidence {
+        assert!((0.0..=1.0).contains(&c), "confidence {c}");
+    }
+    let doubtful = result["doubtful"].as_bool().expect("doubtful is a bool");
+    let threshold = shapecorr::maps::hypotheses::DOUBTFUL_BELOW;
+    assert_eq!(doubtful, confidence.is_some_and(|c| c < threshold));
+    let warning = result["warning"].as_str();
+    assert!(warning.is_some() || result["warning"].is_null());
+    assert_eq!(warning.is_some(), doubtful, "{:?}", result["warning"]);
+    assert!(warning.is_none_or(|w| !w.is_empty()));
+    let hypotheses = result["hypotheses"]
+        .as_array()
+        .expect("hypotheses is a list");
+    assert_eq!(hypotheses.is_empty(), confidence.is_none());
+    if !hypotheses.is_empty() {
+        let chosen = hypotheses.iter().filter(|h| h["chosen"] == true).count();
+        assert_eq!(chosen, 1, "{hypotheses:?}");
+    }
+    for h in hypotheses {
+        assert!(!h["kind"].as_str().unwrap().is_empty());
+        for key in ["cost", "distortion", "coverage", "residual"] {
+            assert!(h[key].as_f64().unwrap() >= 0.0, "{key}: {h}");
+        }
+        assert!(h["coverage"].as_f64().unwrap() <= 1.0);
+        assert!(
+            h["orientation"].is_null() || (0.0..=1.0).contains(&h["orientation"].as_f64().unwrap())
+        );
+    }
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("shapecorr: warning: "))
+        .collect();
+    match warning {
+        Some(w) => assert_eq!(lines, [format!("shapecorr: warning: {w}")], "{stderr}"),
+        None => assert!(lines.is_empty(), "{stderr}"),
+    }
+    confidence
+}
+
 #[test]
 fn synth_info_and_eigen_work_together() {
     let dir = scratch("pipeline");
@@ -202,6 +254,10 @@ fn match_and_symmetry_write_their_results() {
     assert!(!result["matches_one_to_one"].as_array().unwrap().is_empty());
     assert!(result["timings_s"]["total"].as_f64().unwrap() > 0.0);
     assert_eq!(result["version"], env!("CARGO_PKG_VERSION"));
+    let confidence = check_verdict(&result, &String::from_utf8_lossy(&out.stderr));
+    assert!(confidence.is_some(), "verified by default");
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(summary.contains("confidence "), "{summary}");
     // The coloured shapes read back with one colour per vertex.
     for name in ["a_regions.ply", "b_regions.ply"] {
         let raw = shapecorr::shape::io::read_shape(&out_dir.join(name)).unwrap();
@@ -324,6 +380,9 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
                 > 0.0
         );
         assert_eq!(result["regions_b"].as_array().unwrap().len(), n_b);
+        let confidence = check_verdict(&result, &String::from_utf8_lossy(&out.stderr));
+        assert!(confidence.is_some(), "{name}: verified by default");
+        assert!(String::from_utf8_lossy(&out.stdout).contains("confidence "));
         let map =
             shapecorr_eval::bench_pointwise::read_map(&out_dir.join("map_b_to_a.txt")).unwrap();
         assert_eq!(map.len(), n_b);
@@ -492,6 +551,83 @@ fn set_and_the_flag_set_the_same_option() {
     }
     assert_eq!(by_set["regions_a"], by_flag["regions_a"]);
     assert_eq!(by_set["matches"], by_flag["matches"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Without the verification of hypotheses the answer has no confidence: null, not doubtful,
+/// no warning, no hypotheses, and the summary says so.
+#[test]
+fn an_unverified_match_has_no_confidence() {
+    let dir = scratch("unverified");
+    let a = dir.join("a.ply");
+    let b = dir.join("b.ply");
+    for (path, pose) in [(&a, "0"), (&b, "2")] {
+        synth_figure("star4", pose, "1500", path);
+    }
+    let out_dir = dir.join("result");
+    let out = shapecorr(&[
+        "match",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--verify-hypotheses",
+        "false",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("result.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        check_verdict(&result, &String::from_utf8_lossy(&out.stderr)),
+        None
+    );
+    assert_eq!(result["doubtful"], false);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("not verified"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A six-limbed star against a quadruped: no map between them is consistent, so `match` and
+/// `p2p` call the answer doubtful (measured confidence 0.31 and 0.32): the warning is in
+/// result.json, on stderr (one line) and the summary says "doubtful"; the command succeeds.
+#[test]
+fn dissimilar_shapes_are_doubtful_and_warn() {
+    let dir = scratch("doubtful");
+    let a = dir.join("star.ply");
+    let b = dir.join("quadruped.ply");
+    synth_figure("star6", "1", "2000", &a);
+    synth_figure("quadruped", "1", "2000", &b);
+    for command in ["match", "p2p"] {
+        let out_dir = dir.join(command);
+        let out = shapecorr(&[
+            command,
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{command}: {stderr}");
+        let result: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out_dir.join("result.json")).unwrap())
+                .unwrap();
+        let confidence = check_verdict(&result, &stderr);
+        assert!(confidence.is_some(), "{command}");
+        assert_eq!(
+            result["doubtful"], true,
+            "{command}: confidence {confidence:?}"
+        );
+        assert!(
+            stderr.contains("shapecorr: warning: doubtful correspondence"),
+            "{stderr}"
+        );
+        let summary = String::from_utf8_lossy(&out.stdout);
+        assert!(summary.contains(", doubtful"), "{command}: {summary}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -9,8 +9,9 @@ use shapecorr::{Error, Shape};
 
 use crate::options::PointwiseOptions;
 use crate::output::{
-    correspondence_json, create_dir, end_progress_line, options_json, write_colored, write_json,
-    write_map, write_map_colors, TerminalProgress,
+    confidence_summary, correspondence_json, create_dir, end_progress_line, options_json,
+    print_warning, set_verdict_json, write_colored, write_json, write_map, write_map_colors,
+    TerminalProgress,
 };
 
 #[derive(clap::Args)]
@@ -55,18 +56,22 @@ impl P2pArgs {
         value["fmap_size"] = json!(result.map.fmap_ab.nrows());
         value["options"] = options_json(&options, true);
         value["region_times"] = json!(pointwise.region_times);
+        // The answer's verdict: the map's own when it verified hypotheses, else the regions'.
+        set_verdict_json(&mut value, result.verdict());
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result.regions)?;
         write_map_colors(out, &shape_a, &shape_b, map)?;
         println!(
-            "map of {} vertices of B onto A ({} one-to-one region matches, functional map {}x{}); {:.2} s -> {}",
+            "map of {} vertices of B onto A ({} one-to-one region matches, functional map {}x{}, {}); {:.2} s -> {}",
             map.len(),
             result.regions.matches_one_to_one.len(),
             result.map.fmap_ab.nrows(),
             result.map.fmap_ab.ncols(),
+            confidence_summary(result.verdict()),
             result.total,
             out.display()
         );
+        print_warning(result.verdict());
         Ok(())
     }
 }

@@ -10,8 +10,8 @@ use shapecorr::{Error, Shape};
 
 use crate::options::RegionOptions;
 use crate::output::{
-    correspondence_json, create_dir, end_progress_line, graph_json, options_json, write_colored,
-    write_json, TerminalProgress,
+    confidence_summary, correspondence_json, create_dir, end_progress_line, graph_json,
+    options_json, print_warning, write_colored, write_json, TerminalProgress,
 };
 
 #[derive(clap::Args)]
@@ -44,15 +44,17 @@ impl MatchArgs {
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result)?;
         println!(
-            "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one; {:.2} s -> {}",
+            "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one ({}); {:.2} s -> {}",
             result.k,
             result.graph_a.n_nodes(),
             result.graph_b.n_nodes(),
             result.matches.len(),
             result.matches_one_to_one.len(),
+            confidence_summary(result.verdict.as_ref()),
             result.timings.total,
             out.display()
         );
+        print_warning(result.verdict.as_ref());
         Ok(())
     }
 }
