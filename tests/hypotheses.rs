@@ -123,6 +123,9 @@ fn a_forced_mirror_image_answer_gives_the_same_map() {
     assert!((0.0..=1.0).contains(&confidence), "{confidence}");
 }
 
+/// A pose and a body.
+type Side = (usize, Proportions);
+
 /// Hard pairs with known truth: each must stay under the error bound, so a swapped part
 /// (about 0.2 for a limb) fails.
 #[test]
@@ -131,7 +134,7 @@ fn hard_generated_pairs_keep_their_parts() {
         limb_length: 1.25,
         limb_thickness: 0.9,
     };
-    let cases: [(&str, FigureKind, (usize, Proportions), (usize, Proportions)); 3] = [
+    let cases: [(&str, FigureKind, Side, Side); 3] = [
         // Walking: front and back legs apart, of one length.
         (
             "quadruped walk -> paw raised",

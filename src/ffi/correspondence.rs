@@ -442,7 +442,6 @@ mod tests {
                 coverage: 1.0,
                 orientation: Some(1.0),
                 residual: 0.1,
-                descriptor: 0.1,
             },
             fmap_ab: faer::Mat::zeros(2, 2),
             distance_to_chosen,

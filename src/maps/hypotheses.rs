@@ -22,6 +22,9 @@ use crate::spectral::eigen::Eigenbasis;
 /// Corresponding region sets: the A regions and the B regions of each constraint.
 pub type RegionGroups = Vec<(Vec<u32>, Vec<u32>)>;
 
+/// Both shapes' consistently oriented faces ([`Shape::oriented_triangles`]): A's, then B's.
+pub type OrientedFaces = (Vec<[u32; 3]>, Vec<[u32; 3]>);
+
 /// Where a hypothesis comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -402,7 +405,7 @@ impl DistortionProbe {
 pub fn energies(
     (a, basis_a): (&Shape, &Eigenbasis),
     (b, basis_b): (&Shape, &Eigenbasis),
-    faces: Option<&(Vec<[u32; 3]>, Vec<[u32; 3]>)>,
+    faces: Option<&OrientedFaces>,
     sampled: &[SampledZoomOut],
 ) -> Vec<MapEnergy> {
     let Some(first) = sampled.first() else {

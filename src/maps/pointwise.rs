@@ -382,7 +382,7 @@ fn refine(
 fn verified(
     (a, basis_a): (&Shape, &Eigenbasis),
     (b, basis_b): (&Shape, &Eigenbasis),
-    faces: Option<&(Vec<[u32; 3]>, Vec<[u32; 3]>)>,
+    faces: Option<&hypotheses::OrientedFaces>,
     kinds: Vec<HypothesisKind>,
     fmaps: &[Mat<f64>],
     params: &PointwiseParams,

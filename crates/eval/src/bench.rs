@@ -178,6 +178,9 @@ pub fn summary_table(results: &[PairResult]) -> String {
     out
 }
 
+/// A score's label, its (value, pair) per pair, and whether higher is worse.
+type ScoreRow<'a> = (&'a str, Vec<(f64, String)>, bool);
+
 /// The accuracy below which a pair's regions count as failed (the symmetric accuracy of the
 /// paper's method on FAUST is 0.88 on average).
 pub const FAILED_ACCURACY: [f64; 2] = [0.9, 0.8];
@@ -189,7 +192,7 @@ pub fn region_tails_table(results: &[PairResult]) -> String {
     use crate::tails::Tails;
     let name = |r: &PairResult| format!("{} -> {}", r.pair.source, r.pair.target);
     let one_to_one = |r: &PairResult| r.scores.one_to_one_flip.unwrap_or(r.scores.one_to_one);
-    let rows: [(&str, Vec<(f64, String)>, bool); 3] = [
+    let rows: [ScoreRow; 3] = [
         (
             "symmetric",
             results

@@ -253,6 +253,19 @@ pub fn tails_page(records: &[TailRecord], command: &str) -> String {
             );
         }
     }
+    confidence_section(&mut s, records);
+    let seconds: Vec<f64> = records.iter().map(|r| r.seconds).collect();
+    let _ = writeln!(
+        s,
+        "\n{} pairs; regions and map {:.2} s per pair on average (eigenbases cached).",
+        records.len(),
+        seconds.iter().sum::<f64>() / seconds.len().max(1) as f64
+    );
+    s
+}
+
+/// How many failed and good pairs the confidence flags at each threshold.
+fn confidence_section(s: &mut String, records: &[TailRecord]) {
     let _ = writeln!(s, "\n## Confidence\n");
     let _ = writeln!(
         s,
@@ -300,12 +313,4 @@ pub fn tails_page(records: &[TailRecord], command: &str) -> String {
             frac(&good)
         );
     }
-    let seconds: Vec<f64> = records.iter().map(|r| r.seconds).collect();
-    let _ = writeln!(
-        s,
-        "\n{} pairs; regions and map {:.2} s per pair on average (eigenbases cached).",
-        records.len(),
-        seconds.iter().sum::<f64>() / seconds.len().max(1) as f64
-    );
-    s
 }
