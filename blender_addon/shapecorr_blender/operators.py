@@ -18,6 +18,10 @@ COLOR_ATTRIBUTE = "shapecorr_regions"
 #: Integer attribute (point domain): the region id of every vertex.
 REGION_ATTRIBUTE = "shapecorr_region"
 
+#: Custom property (object): the confidence of the last Match Regions, in [0, 1]; absent when
+#: the answer was not verified.
+CONFIDENCE_PROPERTY = "shapecorr_confidence"
+
 #: Pipeline stages as reported by the library, in order (for one overall progress value).
 _STAGES = ["laplacian", "eigenbasis", "descriptors", "segmentation", "matching", "symmetry_breaking"]
 
@@ -87,6 +91,21 @@ def write_regions(obj, regions, rgba):
     mesh.color_attributes.active_color_name = COLOR_ATTRIBUTE
     mesh.color_attributes.render_color_index = mesh.color_attributes.active_color_index
     mesh.update()
+
+
+def confidence_text(confidence):
+    """The confidence for a report: ``confidence 0.74`` or ``not verified`` (None)."""
+    return "not verified" if confidence is None else f"confidence {confidence:.2f}"
+
+
+def write_confidence(obj, confidence):
+    """Stores the confidence as the custom property ``shapecorr_confidence`` of ``obj``
+    (removes an older one when there is none)."""
+    if confidence is None:
+        if CONFIDENCE_PROPERTY in obj:
+            del obj[CONFIDENCE_PROPERTY]
+    else:
+        obj[CONFIDENCE_PROPERTY] = float(confidence)
 
 
 def show_attribute_colors(context):
@@ -227,6 +246,10 @@ class _LibraryOperator:
             return {"CANCELLED"}
         show_attribute_colors(context)
         self.report({"INFO"}, message)
+        # A doubtful answer (results that have a confidence) is also a warning.
+        warning = getattr(result, "warning", None)
+        if warning:
+            self.report({"WARNING"}, f"shapecorr: {warning}")
         return {"FINISHED"}
 
 
@@ -253,13 +276,15 @@ class SHAPECORR_OT_match_regions(_LibraryOperator, bpy.types.Operator):
     def apply(self, context, result):
         one_to_one = context.scene.shapecorr.one_to_one
         objects = [bpy.data.objects[name] for name in self._names]
+        confidence = result.confidence
         for obj, side in zip(objects, ("a", "b")):
             write_regions(obj, result.regions(side), result.colors(side, one_to_one=one_to_one))
+            write_confidence(obj, confidence)
         matches = result.matches_one_to_one if one_to_one else result.matches
         return (
             f"shapecorr: {len(matches)} region matches between '{objects[0].name}' "
             f"({result.n_regions('a')} regions) and '{objects[1].name}' "
-            f"({result.n_regions('b')} regions)"
+            f"({result.n_regions('b')} regions), {confidence_text(confidence)}"
         )
 
 

@@ -3,6 +3,7 @@ unpacked and registered as Blender would load it (a package with relative import
 generated figures become Blender meshes, the operators run, and the attributes they write
 are checked against the library's own result. Run by tests/blender/run.sh."""
 
+import ctypes
 import math
 import os
 import sys
@@ -113,11 +114,63 @@ def test_match_regions_colours_both_meshes_in_place_like_the_library(addon):
         colors = obj.data.color_attributes
         assert colors.active_color_name == addon_module().COLOR_ATTRIBUTE
         assert colors[addon_module().COLOR_ATTRIBUTE].domain == "POINT"
+    # The confidence of the answer is kept on both objects, the library's own (up to the
+    # rounding of the transformed coordinates).
+    assert expected.confidence is not None
+    for obj in (a, b):
+        confidence = obj[addon_module().CONFIDENCE_PROPERTY]
+        assert 0.0 <= confidence <= 1.0
+        assert confidence == pytest.approx(expected.confidence, abs=1e-6)
     # Matched regions really share colours: most vertices (shared vertex order) agree.
     rgba_a, _ = attribute_arrays(a)
     rgba_b, _ = attribute_arrays(b)
     agree = np.mean(np.all(rgba_a == rgba_b, axis=1))
     assert agree >= 0.5, agree
+
+
+def reports(capfd):
+    """The operator reports printed since the last call (headless Blender prints each as
+    ``Info: ...`` or ``Warning: ...``), as (level, text) pairs."""
+    ctypes.CDLL(None).fflush(None)  # Blender prints with C stdio
+    out, err = capfd.readouterr()
+    found = []
+    for line in (out + err).splitlines():
+        level, colon, text = line.partition(": ")
+        if colon and level in ("Info", "Warning", "Error"):
+            found.append((level, text))
+    return found
+
+
+def test_the_confidence_is_reported_and_a_doubtful_answer_warned_about(addon, capfd):
+    """A six-limbed star against a quadruped: no consistent map, the answer is doubtful
+    (confidence 0.31 measured). The info report gives the confidence, a warning report the
+    library's sentence, the objects keep the confidence; without one-to-one matches there is
+    no confidence, and the property goes away."""
+    fresh_scene()
+    sc = addon.shapecorr
+    shapes = [sc.Shape.figure(kind, 1, 2000) for kind in ("star6", "quadruped")]
+    a = add_object("Star", shapes[0].vertices, shapes[0].triangles)
+    b = add_object("Quadruped", shapes[1].vertices, shapes[1].triangles, location=(3.0, 0.0, 0.0))
+    select(a, b)
+    reports(capfd)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}, "a warning is not a failure"
+    expected = sc.match(*[sc.Shape.mesh(s.vertices.astype(np.float32).astype(np.float64), s.triangles) for s in shapes])
+    assert expected.doubtful, expected.confidence
+    found = reports(capfd)
+    info = [text for level, text in found if level == "Info"]
+    assert any(f"confidence {expected.confidence:.2f}" in text for text in info), found
+    assert ("Warning", f"shapecorr: {expected.warning}") in found, found
+    for obj in (a, b):
+        assert obj[addon_module().CONFIDENCE_PROPERTY] == pytest.approx(expected.confidence, abs=1e-6)
+        assert obj[addon_module().CONFIDENCE_PROPERTY] < sc.CONFIDENCE_DOUBTFUL_BELOW
+
+    bpy.context.scene.shapecorr.one_to_one = False
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    found = reports(capfd)
+    assert any("not verified" in text for level, text in found if level == "Info"), found
+    assert not [text for level, text in found if level == "Warning"], found
+    for obj in (a, b):
+        assert addon_module().CONFIDENCE_PROPERTY not in obj
 
 
 def test_undo_removes_the_attributes(addon):
