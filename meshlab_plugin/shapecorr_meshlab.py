@@ -13,6 +13,11 @@ shown by MeshLab's "Colorize by vertex quality") and as the custom attribute
     ms.load_new_mesh("A.ply")
     ms.load_new_mesh("B.ply")
     coloured = shapecorr_meshlab.match_regions(ms)     # a new MeshSet: mesh 0 is A, 1 is B
+    coloured, result = shapecorr_meshlab.match(ms)     # ... and the shapecorr result
+    print("\n".join(shapecorr_meshlab.report(result)))  # its confidence (and warning)
+
+The command prints the answer's confidence (in [0, 1], or "not verified") in its report,
+and when the answer is doubtful a warning on stderr (``shapecorr_meshlab: warning: ...``).
 
 The command's options are generated from the library's option table
 (``shapecorr.options()``, the same as the ``shapecorr`` command line's): one per region
@@ -66,6 +71,22 @@ def match_regions(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, pro
     holding their coloured copies (A first, then B). ``options`` are shapecorr's named
     options (``k_min``, ``k_max``, ...; ``shapecorr.options()`` lists them). Raises
     shapecorr.ShapecorrError on bad input."""
+    return match(ms, id_a, id_b, one_to_one, as_point_cloud, progress, **options)[0]
+
+
+def report(result):
+    """The lines of the report on a match: the confidence of the answer (``confidence
+    0.74``, or ``not verified`` when it has none), and ``warning: ...`` when it is doubtful."""
+    confidence = result.confidence
+    lines = ["not verified" if confidence is None else f"confidence {confidence:.2f}"]
+    if result.warning is not None:
+        lines.append(f"warning: {result.warning}")
+    return lines
+
+
+def match(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, progress=None, **options):
+    """As :func:`match_regions`, returning ``(meshset, result)``: also the
+    shapecorr.Correspondence, for its ``confidence`` and ``warning`` (see :func:`report`)."""
     mesh_a, mesh_b = ms.mesh(id_a), ms.mesh(id_b)
     result = shapecorr.match(
         shape_of(mesh_a, as_point_cloud),
@@ -77,7 +98,7 @@ def match_regions(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, pro
     out = pymeshlab.MeshSet()
     for mesh, side in ((mesh_a, "a"), (mesh_b, "b")):
         out.add_mesh(coloured(mesh, result.regions(side), result.colors(side, one_to_one=one_to_one)))
-    return out
+    return out, result
 
 
 #: Text read as True and as False for a boolean option (as the command line reads them).
@@ -176,14 +197,17 @@ def main(argv=None):
         print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
         return 1
     try:
-        result = match_regions(ms, one_to_one=one_to_one, as_point_cloud=args.points, **options)
+        out, result = match(ms, one_to_one=one_to_one, as_point_cloud=args.points, **options)
     except shapecorr.ShapecorrError as error:
         print(f"shapecorr_meshlab: {error}", file=sys.stderr)
         return 1
     for mesh_id, path in ((0, args.out_a), (1, args.out_b)):
-        result.set_current_mesh(mesh_id)
-        result.save_current_mesh(str(path), save_vertex_color=True, save_vertex_quality=True)
-    print(f"shapecorr_meshlab: wrote {args.out_a} and {args.out_b}")
+        out.set_current_mesh(mesh_id)
+        out.save_current_mesh(str(path), save_vertex_color=True, save_vertex_quality=True)
+    summary, *warnings = report(result)
+    print(f"shapecorr_meshlab: wrote {args.out_a} and {args.out_b} ({summary})")
+    for line in warnings:
+        print(f"shapecorr_meshlab: {line}", file=sys.stderr)
     return 0
 
 

@@ -47,6 +47,14 @@ def test_function_takes_and_returns_a_meshset():
         custom = mesh.vertex_custom_scalar_attribute_array(shapecorr_meshlab.REGION_ATTRIBUTE)
         assert np.array_equal(custom, expected.regions(side))
         assert np.array_equal(mesh.vertex_matrix(), ms.mesh(mesh_id).vertex_matrix())
+    # match() gives the result too: the same confidence, reported on the first line.
+    again, result = shapecorr_meshlab.match(ms, k_max=8)
+    assert again.mesh_number() == 2
+    assert result.confidence is not None and 0.0 <= result.confidence <= 1.0
+    assert result.confidence == expected.confidence
+    lines = shapecorr_meshlab.report(result)
+    assert lines[0] == f"confidence {expected.confidence:.2f}"
+    assert lines[1:] == ([f"warning: {expected.warning}"] if expected.doubtful else [])
 
 
 def run_script(*args):
@@ -72,6 +80,24 @@ def test_command_writes_coloured_files_with_region_ids(tmp_path):
     ms.load_new_mesh(str(tmp_path / "b_col.ply"))
     agree = np.mean(np.all(ms.mesh(0).vertex_color_matrix() == ms.mesh(1).vertex_color_matrix(), axis=1))
     assert agree > 0.5, agree
+    # The report gives the confidence; a warning on stderr only when doubtful.
+    assert expected.confidence is not None
+    assert f"(confidence {expected.confidence:.2f})" in done.stdout, done.stdout
+    assert ("shapecorr_meshlab: warning:" in done.stderr) == expected.doubtful, done.stderr
+
+
+def test_a_doubtful_answer_is_reported_with_its_warning(tmp_path):
+    """A six-limbed star against a quadruped: no consistent map (confidence 0.31 measured),
+    so the command warns on stderr with the library's sentence, and still writes the files."""
+    save(figure_mesh("star6", 1, 2000), tmp_path / "a.ply")
+    save(figure_mesh("quadruped", 1, 2000), tmp_path / "b.ply")
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "a_col.ply", "--out-b", tmp_path / "b_col.ply")
+    assert done.returncode == 0, done.stderr
+    expected = shapecorr.match(shapecorr.Shape.read(tmp_path / "a.ply"), shapecorr.Shape.read(tmp_path / "b.ply"))
+    assert expected.doubtful, expected.confidence
+    assert f"(confidence {expected.confidence:.2f})" in done.stdout, done.stdout
+    assert f"shapecorr_meshlab: warning: {expected.warning}" in done.stderr.splitlines(), done.stderr
+    assert (tmp_path / "a_col.ply").exists() and (tmp_path / "b_col.ply").exists()
 
 
 def test_a_format_only_meshlab_reads(tmp_path):
@@ -81,6 +107,7 @@ def test_a_format_only_meshlab_reads(tmp_path):
         shapecorr.Shape.read(tmp_path / "a.stl")  # the library has no STL reader
     done = run_script(tmp_path / "a.stl", tmp_path / "b.ply", "--out-a", tmp_path / "a_col.ply", "--out-b", tmp_path / "b_col.ply", "--symmetric")
     assert done.returncode == 0, done.stderr
+    assert "(not verified)" in done.stdout, "symmetric matches have no confidence"
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(tmp_path / "a_col.ply"))
     mesh = ms.current_mesh()
