@@ -256,6 +256,15 @@ def test_life_cycle(humanoids):
     assert result.confidence is not None, "verified by default"
 
 
+def test_dissimilar_shapes_are_doubtful_with_a_warning():
+    """A six-limbed star against a quadruped: no consistent map (confidence 0.31 measured)."""
+    a, b = shapecorr.Shape.figure("star6", 1, 2000), shapecorr.Shape.figure("quadruped", 1, 2000)
+    result = shapecorr.match(a, b)
+    check_confidence(result)
+    assert result.doubtful and result.confidence < shapecorr.CONFIDENCE_DOUBTFUL_BELOW
+    assert result.warning.startswith("doubtful correspondence"), result.warning
+
+
 def test_no_confidence_without_verification():
     a, b = shapecorr.Shape.figure("star4", 0, 1500), shapecorr.Shape.figure("star4", 2, 1500)
     for options in (dict(verify_hypotheses=False), dict(one_to_one=False)):
