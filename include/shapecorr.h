@@ -69,7 +69,7 @@
 // Below this confidence (`sc_correspondence_confidence`, `sc_pointwise_confidence`) an
 // answer is doubtful and has a warning (`sc_correspondence_warning`,
 // `sc_pointwise_warning`).
-#define SC_CONFIDENCE_DOUBTFUL_BELOW 0.5
+#define SC_CONFIDENCE_DOUBTFUL_BELOW 0.45
 
 // An integer option (`sc_params_set_int`).
 #define SC_OPTION_INT 0

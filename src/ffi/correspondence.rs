@@ -54,7 +54,7 @@ pub const SC_MATCHES_ONE_TO_ONE: u32 = 1;
 /// Below this confidence (`sc_correspondence_confidence`, `sc_pointwise_confidence`) an
 /// answer is doubtful and has a warning (`sc_correspondence_warning`,
 /// `sc_pointwise_warning`).
-pub const SC_CONFIDENCE_DOUBTFUL_BELOW: f64 = 0.5;
+pub const SC_CONFIDENCE_DOUBTFUL_BELOW: f64 = 0.45;
 
 /// Region correspondence between shapes `a` and `b` (meshes, point clouds or one of each):
 /// eigenbases, heat kernel signatures, joint segmentation over the range of k, spectral

@@ -357,7 +357,7 @@ class Correspondence(_Handle):
     @property
     def confidence(self):
         """The confidence of the one-to-one answer, a float in [0, 1] (below
-        ``CONFIDENCE_DOUBTFUL_BELOW``, 0.5, the answer is doubtful), or None when it was not
+        ``CONFIDENCE_DOUBTFUL_BELOW``, 0.45, the answer is doubtful), or None when it was not
         verified (``verify_hypotheses=False``, ``one_to_one=False``, or nothing to choose
         from)."""
         return _confidence(lib.sc_correspondence_confidence(self))
