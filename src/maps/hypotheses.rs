@@ -1,4 +1,4 @@
-//! Region hypotheses verified at the map level (docs/design.md, step 14; issue 18).
+//! Region hypotheses verified at the map level (docs/design.md, 12.1 and 13.4; issue 18).
 //!
 //! A one-to-one region answer can be wrong in ways the region energy cannot see: the
 //! mirror image of the truth (paper, section 5.2), or two parts of one symmetric group
