@@ -98,6 +98,23 @@
 // Option `p2p_refinement`: spectral ICP.
 #define SC_P2P_REFINEMENT_ICP 2
 
+// Repair flags of the `*_repaired` constructors: weld coincident vertices (seams,
+// triangle soups).
+#define SC_REPAIR_WELD 1
+
+// Repair flag: leave out small loose pieces (scan debris).
+#define SC_REPAIR_DEBRIS 2
+
+// Repair flag: leave out far vertices and a point cloud's isolated points.
+#define SC_REPAIR_OUTLIERS 4
+
+// Every repair (what `sc_shape_new_mesh`, `sc_shape_new_point_cloud` and `sc_shape_read`
+// make).
+#define SC_REPAIR_ALL ((SC_REPAIR_WELD | SC_REPAIR_DEBRIS) | SC_REPAIR_OUTLIERS)
+
+// No repair: the shape is used as given.
+#define SC_REPAIR_NONE 0
+
 // Status of every fallible call. The numbers never change meaning; new codes are added.
 enum sc_status
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -539,7 +556,10 @@ const char *sc_pointwise_warning(const sc_pointwise *pointwise);
 // Errors: `SC_STATUS_NON_FINITE_COORDINATE`, `SC_STATUS_FACE_INDEX_OUT_OF_RANGE`,
 // `SC_STATUS_TOO_FEW_VERTICES` (fewer than 32 used vertices), `SC_STATUS_ZERO_AREA`.
 // Degenerate, duplicate or non-manifold faces and disconnected pieces are accepted and
-// reported by `sc_shape_warnings`.
+// reported by `sc_shape_warnings`, as are the repairs made (`SC_REPAIR_ALL`: coincident
+// vertices welded, small loose pieces and far vertices left out; every vertex keeps its
+// index, a repaired-away one takes the answer of its nearest kept vertex).
+// `sc_shape_new_mesh_repaired` chooses the repairs.
 //
 // # Safety
 // `xyz` must point to `3 * n_vertices` doubles and `triangles` to `3 * n_triangles`
@@ -566,6 +586,38 @@ sc_status sc_shape_new_mesh_f32(const float *xyz,
 // # Safety
 // `xyz` must point to `3 * n_points` doubles; `out_shape` must be writable.
 sc_status sc_shape_new_point_cloud(const double *xyz, size_t n_points, sc_shape **out_shape);
+
+// As `sc_shape_new_mesh` with the repairs `repairs` (`SC_REPAIR_*` flags or-ed together;
+// `SC_REPAIR_NONE` uses the mesh as given). Other bits: `SC_STATUS_INVALID_PARAMETER`.
+//
+// # Safety
+// As `sc_shape_new_mesh`.
+sc_status sc_shape_new_mesh_repaired(const double *xyz,
+                                     size_t n_vertices,
+                                     const uint32_t *triangles,
+                                     size_t n_triangles,
+                                     uint32_t repairs,
+                                     sc_shape **out_shape);
+
+// As `sc_shape_new_point_cloud` with the repairs `repairs` (`SC_REPAIR_*` flags; the
+// default `SC_REPAIR_ALL` welds coincident points and leaves out far and isolated points
+// and small loose clusters).
+//
+// # Safety
+// As `sc_shape_new_point_cloud`.
+sc_status sc_shape_new_point_cloud_repaired(const double *xyz,
+                                            size_t n_points,
+                                            uint32_t repairs,
+                                            sc_shape **out_shape);
+
+// As `sc_shape_read` with the repairs `repairs` (`SC_REPAIR_*` flags).
+//
+// # Safety
+// As `sc_shape_read`.
+sc_status sc_shape_read_repaired(const char *path,
+                                 bool as_point_cloud,
+                                 uint32_t repairs,
+                                 sc_shape **out_shape);
 
 // As `sc_shape_new_point_cloud` with single-precision coordinates.
 //
@@ -640,6 +692,14 @@ sc_status sc_shape_triangles(const sc_shape *shape, uint32_t *out_triangles, siz
 // # Safety
 // `shape` must be NULL or a live shape; `buf` must point to `len` writable bytes.
 size_t sc_shape_warnings(const sc_shape *shape, char *buf, size_t len);
+
+// The repairs made to the shape (coincident vertices welded, small loose pieces, far
+// vertices or isolated points left out), one per line, as `sc_shape_warnings` (of whose
+// lines they are a part) writes them. Returns 0 for NULL `shape` or a shape used as given.
+//
+// # Safety
+// `shape` must be NULL or a live shape; `buf` must point to `len` writable bytes.
+size_t sc_shape_repairs(const sc_shape *shape, char *buf, size_t len);
 
 // Symmetric regions of one shape, found by matching the shape to itself: its regions and
 // groups of mutually symmetric regions (the limbs of a star, left and right limbs of a

@@ -74,31 +74,35 @@ def match_regions(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, pro
     return match(ms, id_a, id_b, one_to_one, as_point_cloud, progress, **options)[0]
 
 
-def report(result):
+def report(result, shapes=()):
     """The lines of the report on a match: the confidence of the answer (``confidence
-    0.74``, or ``not verified`` when it has none), and ``warning: ...`` when it is doubtful."""
+    0.74``, or ``not verified`` when it has none), ``warning: ...`` when it is doubtful,
+    and ``repaired A: ...`` for every repair the library made to ``shapes`` (A, then B)."""
     confidence = result.confidence
     lines = ["not verified" if confidence is None else f"confidence {confidence:.2f}"]
     if result.warning is not None:
         lines.append(f"warning: {result.warning}")
+    for side, shape in zip("AB", shapes):
+        lines.extend(f"repaired {side}: {repair}" for repair in shape.repairs)
     return lines
 
 
 def match(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, progress=None, **options):
     """As :func:`match_regions`, returning ``(meshset, result)``: also the
     shapecorr.Correspondence, for its ``confidence`` and ``warning`` (see :func:`report`)."""
+    return match_with_shapes(ms, id_a, id_b, one_to_one, as_point_cloud, progress, **options)[:2]
+
+
+def match_with_shapes(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, progress=None, **options):
+    """As :func:`match`, returning ``(meshset, result, (shape_a, shape_b))``: also the
+    shapecorr shapes, for the repairs the library made to them (see :func:`report`)."""
     mesh_a, mesh_b = ms.mesh(id_a), ms.mesh(id_b)
-    result = shapecorr.match(
-        shape_of(mesh_a, as_point_cloud),
-        shape_of(mesh_b, as_point_cloud),
-        progress=progress,
-        one_to_one=one_to_one,
-        **options,
-    )
+    shapes = (shape_of(mesh_a, as_point_cloud), shape_of(mesh_b, as_point_cloud))
+    result = shapecorr.match(*shapes, progress=progress, one_to_one=one_to_one, **options)
     out = pymeshlab.MeshSet()
     for mesh, side in ((mesh_a, "a"), (mesh_b, "b")):
         out.add_mesh(coloured(mesh, result.regions(side), result.colors(side, one_to_one=one_to_one)))
-    return out, result
+    return out, result, shapes
 
 
 #: Text read as True and as False for a boolean option (as the command line reads them).
@@ -197,14 +201,16 @@ def main(argv=None):
         print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
         return 1
     try:
-        out, result = match(ms, one_to_one=one_to_one, as_point_cloud=args.points, **options)
+        out, result, shapes = match_with_shapes(
+            ms, one_to_one=one_to_one, as_point_cloud=args.points, **options
+        )
     except shapecorr.ShapecorrError as error:
         print(f"shapecorr_meshlab: {error}", file=sys.stderr)
         return 1
     for mesh_id, path in ((0, args.out_a), (1, args.out_b)):
         out.set_current_mesh(mesh_id)
         out.save_current_mesh(str(path), save_vertex_color=True, save_vertex_quality=True)
-    summary, *warnings = report(result)
+    summary, *warnings = report(result, shapes)
     print(f"shapecorr_meshlab: wrote {args.out_a} and {args.out_b} ({summary})")
     for line in warnings:
         print(f"shapecorr_meshlab: {line}", file=sys.stderr)

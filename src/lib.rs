@@ -64,7 +64,7 @@ pub use correspondence::{Correspondence, Params, Symmetry};
 pub use error::{Error, Result};
 pub use maps::pointwise::{PointwiseCorrespondence, PointwiseParams};
 pub use progress::{NoProgress, Progress, Stage};
-pub use shape::{ReadAs, Shape, ShapeKind, Warning};
+pub use shape::{ReadAs, Repairs, Shape, ShapeKind, Warning};
 pub use spectral::eigen::{EigenParams, Eigenbasis};
 
 /// The hidden last field of every params struct (faer's pattern): callers outside the crate

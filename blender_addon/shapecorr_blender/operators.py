@@ -75,6 +75,11 @@ def read_shape(obj, depsgraph, as_point_cloud):
     return shapecorr.Shape.mesh(world, triangles.reshape(-1, 3))
 
 
+def repair_notes(names, shapes):
+    """The repairs the library made to each object's shape, one report line each."""
+    return [f"shapecorr: '{name}': {repair}" for name, shape in zip(names, shapes) for repair in shape.repairs]
+
+
 def write_regions(obj, regions, rgba):
     """Writes the region ids and colours as point attributes of ``obj``'s mesh, makes the
     colour attribute the active (and rendered) one."""
@@ -246,6 +251,9 @@ class _LibraryOperator:
             return {"CANCELLED"}
         show_attribute_colors(context)
         self.report({"INFO"}, message)
+        # What the library repaired in the input (welded seams, debris left out, ...).
+        for note in getattr(self, "_repairs", []):
+            self.report({"WARNING"}, note)
         # A doubtful answer (results that have a confidence) is also a warning.
         warning = getattr(result, "warning", None)
         if warning:
@@ -266,6 +274,7 @@ class SHAPECORR_OT_match_regions(_LibraryOperator, bpy.types.Operator):
         objects = ordered_selection(context)
         shapes = [read_shape(o, depsgraph, settings.point_cloud) for o in objects]
         self._names = [o.name for o in objects]
+        self._repairs = repair_notes(self._names, shapes)
         options = settings.library_options()
 
         def work(progress):
@@ -300,6 +309,7 @@ class SHAPECORR_OT_detect_symmetry(_LibraryOperator, bpy.types.Operator):
         obj = ordered_selection(context)[0]
         shape = read_shape(obj, context.evaluated_depsgraph_get(), settings.point_cloud)
         self._names = [obj.name]
+        self._repairs = repair_notes(self._names, [shape])
         options = settings.library_options(one_to_one=False)
 
         def work(progress):

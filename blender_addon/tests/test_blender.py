@@ -173,6 +173,40 @@ def test_the_confidence_is_reported_and_a_doubtful_answer_warned_about(addon, ca
         assert addon_module().CONFIDENCE_PROPERTY not in obj
 
 
+def seam_split(vertices, triangles):
+    """The faces on the +x side get their own copies of the vertices they share with the -x
+    side (appended), as exporters split a mesh along a UV seam. Returns the vertices, the
+    triangles and, per vertex, the figure vertex it copies."""
+    right = vertices[triangles].sum(axis=1)[:, 0] > 0.0
+    on_left = np.zeros(len(vertices), dtype=bool)
+    on_left[triangles[~right].ravel()] = True
+    shared = np.unique(triangles[right].ravel()[on_left[triangles[right].ravel()]])
+    copy = np.arange(len(vertices))
+    copy[shared] = len(vertices) + np.arange(len(shared))
+    split = triangles.copy()
+    split[right] = copy[triangles[right]]
+    original = np.concatenate([np.arange(len(vertices)), shared])
+    return vertices[original], split, original
+
+
+def test_a_mesh_split_along_a_seam_is_welded_and_the_repair_reported(addon, capfd):
+    """Vertices duplicated along a seam: the library welds them (a warning report says so)
+    and every copy gets the region of the vertex it copies."""
+    fresh_scene()
+    (va, ta), (vb, tb) = figures(addon)
+    vertices, triangles, original = seam_split(va, ta)
+    assert len(vertices) > len(va) + 20
+    a = add_object("Seamed", vertices, triangles)
+    b = add_object("Posed", vb, tb, location=(3.0, 0.0, 0.0))
+    select(a, b)
+    reports(capfd)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    found = reports(capfd)
+    assert any(level == "Warning" and "'Seamed'" in text and "welded" in text for level, text in found), found
+    _, regions = attribute_arrays(a)
+    assert np.array_equal(regions[len(va):], regions[original[len(va):]])
+
+
 def test_undo_removes_the_attributes(addon):
     operator = addon.operators.SHAPECORR_OT_match_regions
     assert {"REGISTER", "UNDO"} <= operator.bl_options

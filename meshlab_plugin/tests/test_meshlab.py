@@ -150,3 +150,27 @@ def test_bad_options_exit_with_a_reason(tmp_path):
     for args, expected in ((["--set", "nope=1"], "nope"), (["--k-min", "five"], "k_min"), (["--gap-ratio", "x"], "gap_ratio")):
         done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply", *args)
         assert done.returncode == 2 and expected in done.stderr, (args, done.stderr)
+
+
+def test_the_repairs_made_are_reported(tmp_path):
+    """B is a point cloud with one far stray point: the library leaves it out, and the
+    report (and the command's stderr) says so, naming B."""
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(figure_mesh("humanoid", 0))
+    points = shapecorr.Shape.figure("humanoid", 3, 2500).vertices
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=np.vstack([points, [[50.0, 50.0, 50.0]]])))
+    _, result, shapes = shapecorr_meshlab.match_with_shapes(ms)
+    lines = shapecorr_meshlab.report(result, shapes)
+    assert [line for line in lines if line.startswith("repaired")] == [
+        f"repaired B: {repair}" for repair in shapes[1].repairs
+    ]
+    assert any("far from" in line for line in lines), lines
+    save(ms.mesh(0), tmp_path / "a.ply")
+    save(ms.mesh(1), tmp_path / "b.ply")
+    run = subprocess.run(
+        [sys.executable, str(SCRIPT), str(tmp_path / "a.ply"), str(tmp_path / "b.ply"),
+         "--out-a", str(tmp_path / "a_out.ply"), "--out-b", str(tmp_path / "b_out.ply")],
+        capture_output=True, text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "shapecorr_meshlab: repaired B: 1 vertices far from" in run.stderr, run.stderr

@@ -6,6 +6,7 @@ use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_slice, input_str,
     write_output, Failure, FfiResult, ScStatus,
 };
+use crate::shape::Repairs;
 use crate::synth::{self, FigureKind, FigureSpec, Proportions};
 use crate::{ReadAs, Shape, ShapeKind};
 
@@ -29,11 +30,66 @@ unsafe fn xyz_input<'a, T>(xyz: *const T, n_vertices: usize) -> FfiResult<&'a [T
     input_slice(xyz, len, "xyz")
 }
 
+/// Repair flags of the `*_repaired` constructors: weld coincident vertices (seams,
+/// triangle soups).
+pub const SC_REPAIR_WELD: u32 = 1;
+/// Repair flag: leave out small loose pieces (scan debris).
+pub const SC_REPAIR_DEBRIS: u32 = 2;
+/// Repair flag: leave out far vertices and a point cloud's isolated points.
+pub const SC_REPAIR_OUTLIERS: u32 = 4;
+/// Every repair (what `sc_shape_new_mesh`, `sc_shape_new_point_cloud` and `sc_shape_read`
+/// make).
+pub const SC_REPAIR_ALL: u32 = SC_REPAIR_WELD | SC_REPAIR_DEBRIS | SC_REPAIR_OUTLIERS;
+/// No repair: the shape is used as given.
+pub const SC_REPAIR_NONE: u32 = 0;
+
+/// The repairs of `flags` (`SC_REPAIR_*`) with the default tolerances.
+fn repairs_of(flags: u32) -> Result<Repairs, Failure> {
+    if flags & !SC_REPAIR_ALL != 0 {
+        return Err(Failure::invalid(format!(
+            "repair flags {flags:#x}: only SC_REPAIR_WELD (1), SC_REPAIR_DEBRIS (2) and SC_REPAIR_OUTLIERS (4) exist"
+        )));
+    }
+    let default = Repairs::default();
+    let on = |flag: u32| flags & flag != 0;
+    Ok(Repairs {
+        weld_tolerance: if on(SC_REPAIR_WELD) {
+            default.weld_tolerance
+        } else {
+            0.0
+        },
+        debris_fraction: if on(SC_REPAIR_DEBRIS) {
+            default.debris_fraction
+        } else {
+            0.0
+        },
+        outliers: on(SC_REPAIR_OUTLIERS),
+    })
+}
+
 unsafe fn new_mesh<T: Copy + Into<f64>>(
     xyz: *const T,
     n_vertices: usize,
     triangles: *const u32,
     n_triangles: usize,
+    out_shape: *mut *mut ScShape,
+) -> ScStatus {
+    new_mesh_repaired(
+        xyz,
+        n_vertices,
+        triangles,
+        n_triangles,
+        SC_REPAIR_ALL,
+        out_shape,
+    )
+}
+
+unsafe fn new_mesh_repaired<T: Copy + Into<f64>>(
+    xyz: *const T,
+    n_vertices: usize,
+    triangles: *const u32,
+    n_triangles: usize,
+    repairs: u32,
     out_shape: *mut *mut ScShape,
 ) -> ScStatus {
     boundary(|| {
@@ -43,11 +99,8 @@ unsafe fn new_mesh<T: Copy + Into<f64>>(
             .checked_mul(3)
             .ok_or_else(|| Failure::invalid(format!("n_triangles = {n_triangles} is too large")))?;
         let corners = input_slice(triangles, len, "triangles")?;
-        let triangles: Vec<[u32; 3]> = corners
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect();
-        let shape = Shape::mesh(points_from(xyz), &triangles)?;
+        let triangles: Vec<Vec<u32>> = corners.chunks_exact(3).map(<[u32]>::to_vec).collect();
+        let shape = Shape::mesh_with(points_from(xyz), &triangles, &repairs_of(repairs)?)?;
         give_handle(out_shape, ScShape { shape })
     })
 }
@@ -55,12 +108,13 @@ unsafe fn new_mesh<T: Copy + Into<f64>>(
 unsafe fn new_point_cloud<T: Copy + Into<f64>>(
     xyz: *const T,
     n_points: usize,
+    repairs: u32,
     out_shape: *mut *mut ScShape,
 ) -> ScStatus {
     boundary(|| {
         check_out(out_shape, "out_shape")?;
         let xyz = xyz_input(xyz, n_points)?;
-        let shape = Shape::point_cloud(points_from(xyz))?;
+        let shape = Shape::point_cloud_with(points_from(xyz), &repairs_of(repairs)?)?;
         give_handle(out_shape, ScShape { shape })
     })
 }
@@ -72,7 +126,10 @@ unsafe fn new_point_cloud<T: Copy + Into<f64>>(
 /// Errors: `SC_STATUS_NON_FINITE_COORDINATE`, `SC_STATUS_FACE_INDEX_OUT_OF_RANGE`,
 /// `SC_STATUS_TOO_FEW_VERTICES` (fewer than 32 used vertices), `SC_STATUS_ZERO_AREA`.
 /// Degenerate, duplicate or non-manifold faces and disconnected pieces are accepted and
-/// reported by `sc_shape_warnings`.
+/// reported by `sc_shape_warnings`, as are the repairs made (`SC_REPAIR_ALL`: coincident
+/// vertices welded, small loose pieces and far vertices left out; every vertex keeps its
+/// index, a repaired-away one takes the answer of its nearest kept vertex).
+/// `sc_shape_new_mesh_repaired` chooses the repairs.
 ///
 /// # Safety
 /// `xyz` must point to `3 * n_vertices` doubles and `triangles` to `3 * n_triangles`
@@ -114,7 +171,63 @@ pub unsafe extern "C" fn sc_shape_new_point_cloud(
     n_points: usize,
     out_shape: *mut *mut ScShape,
 ) -> ScStatus {
-    new_point_cloud(xyz, n_points, out_shape)
+    new_point_cloud(xyz, n_points, SC_REPAIR_ALL, out_shape)
+}
+
+/// As `sc_shape_new_mesh` with the repairs `repairs` (`SC_REPAIR_*` flags or-ed together;
+/// `SC_REPAIR_NONE` uses the mesh as given). Other bits: `SC_STATUS_INVALID_PARAMETER`.
+///
+/// # Safety
+/// As `sc_shape_new_mesh`.
+#[no_mangle]
+pub unsafe extern "C" fn sc_shape_new_mesh_repaired(
+    xyz: *const f64,
+    n_vertices: usize,
+    triangles: *const u32,
+    n_triangles: usize,
+    repairs: u32,
+    out_shape: *mut *mut ScShape,
+) -> ScStatus {
+    new_mesh_repaired(xyz, n_vertices, triangles, n_triangles, repairs, out_shape)
+}
+
+/// As `sc_shape_new_point_cloud` with the repairs `repairs` (`SC_REPAIR_*` flags; the
+/// default `SC_REPAIR_ALL` welds coincident points and leaves out far and isolated points
+/// and small loose clusters).
+///
+/// # Safety
+/// As `sc_shape_new_point_cloud`.
+#[no_mangle]
+pub unsafe extern "C" fn sc_shape_new_point_cloud_repaired(
+    xyz: *const f64,
+    n_points: usize,
+    repairs: u32,
+    out_shape: *mut *mut ScShape,
+) -> ScStatus {
+    new_point_cloud(xyz, n_points, repairs, out_shape)
+}
+
+/// As `sc_shape_read` with the repairs `repairs` (`SC_REPAIR_*` flags).
+///
+/// # Safety
+/// As `sc_shape_read`.
+#[no_mangle]
+pub unsafe extern "C" fn sc_shape_read_repaired(
+    path: *const c_char,
+    as_point_cloud: bool,
+    repairs: u32,
+    out_shape: *mut *mut ScShape,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_shape, "out_shape")?;
+        let path = input_str(path, "path")?;
+        let shape = Shape::read_with(
+            std::path::Path::new(path),
+            ReadAs::point_cloud_when(as_point_cloud),
+            &repairs_of(repairs)?,
+        )?;
+        give_handle(out_shape, ScShape { shape })
+    })
 }
 
 /// As `sc_shape_new_point_cloud` with single-precision coordinates.
@@ -127,7 +240,7 @@ pub unsafe extern "C" fn sc_shape_new_point_cloud_f32(
     n_points: usize,
     out_shape: *mut *mut ScShape,
 ) -> ScStatus {
-    new_point_cloud(xyz, n_points, out_shape)
+    new_point_cloud(xyz, n_points, SC_REPAIR_ALL, out_shape)
 }
 
 /// Reads a shape from a file: OFF, OBJ, PLY (ascii or binary) or XYZ/PTS points, chosen by
@@ -277,6 +390,31 @@ pub unsafe extern "C" fn sc_shape_warnings(
     boundary_value(0, || {
         let shape = &handle(shape, "shape")?.shape;
         let text: String = shape.warnings().iter().map(|w| format!("{w}\n")).collect();
+        write_c_string(&text, buf, len)?;
+        Ok(text.len())
+    })
+}
+
+/// The repairs made to the shape (coincident vertices welded, small loose pieces, far
+/// vertices or isolated points left out), one per line, as `sc_shape_warnings` (of whose
+/// lines they are a part) writes them. Returns 0 for NULL `shape` or a shape used as given.
+///
+/// # Safety
+/// `shape` must be NULL or a live shape; `buf` must point to `len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn sc_shape_repairs(
+    shape: *const ScShape,
+    buf: *mut c_char,
+    len: usize,
+) -> usize {
+    boundary_value(0, || {
+        let shape = &handle(shape, "shape")?.shape;
+        let text: String = shape
+            .warnings()
+            .iter()
+            .filter(|w| w.is_repair())
+            .map(|w| format!("{w}\n"))
+            .collect();
         write_c_string(&text, buf, len)?;
         Ok(text.len())
     })

@@ -9,11 +9,13 @@
 
 pub mod io;
 pub mod neighbors;
+pub mod repair;
 
 use std::collections::HashMap;
 
 use crate::shape::io::RawShape;
 use crate::shape::neighbors::{symmetric_knn_graph, PointTree};
+pub use crate::shape::repair::Repairs;
 use crate::{Error, Result};
 
 /// Fewest usable vertices the pipeline accepts. The point-cloud Laplacian looks at
@@ -110,6 +112,46 @@ pub enum Warning {
         /// Number of triangles with area below 1e-8 times the mean triangle area.
         count: usize,
     },
+    /// Coincident vertices (UV seams, hard edges, triangle soups) were welded
+    /// ([`Repairs::weld_tolerance`]); each takes the values of the vertex it was welded to.
+    VerticesWelded {
+        /// Number of vertices welded into another one.
+        count: usize,
+    },
+    /// Small connected pieces (scan debris) were left out ([`Repairs::debris_fraction`]);
+    /// their vertices take the values of the nearest kept vertex.
+    SmallPiecesDropped {
+        /// Number of pieces left out.
+        pieces: usize,
+        /// Number of their vertices.
+        vertices: usize,
+    },
+    /// Vertices far from the rest of the shape were left out ([`Repairs::outliers`]), with
+    /// their faces; they take the values of the nearest kept vertex.
+    FarVerticesDropped {
+        /// Number of vertices left out.
+        count: usize,
+    },
+    /// Isolated points of a point cloud (local-density test) were left out of the
+    /// Laplacian and the area ([`Repairs::outliers`]); they take the values of the nearest
+    /// kept point.
+    OutlierPointsDropped {
+        /// Number of points left out.
+        count: usize,
+    },
+}
+
+impl Warning {
+    /// Whether it reports a repair ([`Repairs`]) rather than something merely noticed.
+    pub fn is_repair(&self) -> bool {
+        matches!(
+            self,
+            Warning::VerticesWelded { .. }
+                | Warning::SmallPiecesDropped { .. }
+                | Warning::FarVerticesDropped { .. }
+                | Warning::OutlierPointsDropped { .. }
+        )
+    }
 }
 
 impl std::fmt::Display for Warning {
@@ -142,6 +184,22 @@ impl std::fmt::Display for Warning {
                 f,
                 "{count} faces have (near) zero area; the Laplacian mollifies them"
             ),
+            Warning::VerticesWelded { count } => write!(
+                f,
+                "{count} coincident vertices welded (seams or an unwelded export); they share the answer of the vertex they were welded to"
+            ),
+            Warning::SmallPiecesDropped { pieces, vertices } => write!(
+                f,
+                "{pieces} small loose pieces ({vertices} vertices) left out as debris; they take the answer of the nearest kept vertex"
+            ),
+            Warning::FarVerticesDropped { count } => write!(
+                f,
+                "{count} vertices far from the rest of the shape left out; they take the answer of the nearest kept vertex"
+            ),
+            Warning::OutlierPointsDropped { count } => write!(
+                f,
+                "{count} isolated outlier points left out; they take the answer of the nearest kept point"
+            ),
         }
     }
 }
@@ -162,39 +220,69 @@ pub struct Shape {
 }
 
 impl Shape {
-    /// A triangle mesh. Faces are validated and cleaned; see the module docs.
+    /// A triangle mesh. Faces are validated and cleaned, and the default [`Repairs`] made;
+    /// see the module docs.
     pub fn mesh(vertices: Vec<[f64; 3]>, triangles: &[[u32; 3]]) -> Result<Shape> {
         let polygons: Vec<&[u32]> = triangles.iter().map(|t| t.as_slice()).collect();
-        Shape::build(vertices, &polygons, ShapeKind::Mesh)
+        Shape::build(vertices, &polygons, ShapeKind::Mesh, &Repairs::default())
     }
 
     /// A mesh from polygons of any size (quads and n-gons are triangulated).
     pub fn mesh_from_polygons(vertices: Vec<[f64; 3]>, polygons: &[Vec<u32>]) -> Result<Shape> {
-        let polygons: Vec<&[u32]> = polygons.iter().map(|p| p.as_slice()).collect();
-        Shape::build(vertices, &polygons, ShapeKind::Mesh)
+        Shape::mesh_with(vertices, polygons, &Repairs::default())
     }
 
-    /// A point cloud (no faces).
+    /// A mesh from polygons, with the given repairs ([`Repairs::none`] for none).
+    pub fn mesh_with(
+        vertices: Vec<[f64; 3]>,
+        polygons: &[Vec<u32>],
+        repairs: &Repairs,
+    ) -> Result<Shape> {
+        let polygons: Vec<&[u32]> = polygons.iter().map(|p| p.as_slice()).collect();
+        Shape::build(vertices, &polygons, ShapeKind::Mesh, repairs)
+    }
+
+    /// A point cloud (no faces), with the default [`Repairs`].
     pub fn point_cloud(vertices: Vec<[f64; 3]>) -> Result<Shape> {
-        Shape::build(vertices, &[], ShapeKind::PointCloud)
+        Shape::point_cloud_with(vertices, &Repairs::default())
+    }
+
+    /// A point cloud with the given repairs.
+    pub fn point_cloud_with(vertices: Vec<[f64; 3]>, repairs: &Repairs) -> Result<Shape> {
+        Shape::build(vertices, &[], ShapeKind::PointCloud, repairs)
     }
 
     /// A shape from a file's contents: a point cloud when it has no faces or when `read_as`
     /// says so, a mesh otherwise.
     pub fn from_raw(raw: RawShape, read_as: ReadAs) -> Result<Shape> {
+        Shape::from_raw_with(raw, read_as, &Repairs::default())
+    }
+
+    /// [`Shape::from_raw`] with the given repairs.
+    pub fn from_raw_with(raw: RawShape, read_as: ReadAs, repairs: &Repairs) -> Result<Shape> {
         if read_as == ReadAs::PointCloud || raw.polygons.is_empty() {
-            Shape::point_cloud(raw.vertices)
+            Shape::point_cloud_with(raw.vertices, repairs)
         } else {
-            Shape::mesh_from_polygons(raw.vertices, &raw.polygons)
+            Shape::mesh_with(raw.vertices, &raw.polygons, repairs)
         }
     }
 
     /// Reads a file (OFF, OBJ, PLY, XYZ/PTS) into a shape: `Shape::read(path, ReadAs::Auto)`.
     pub fn read(path: &std::path::Path, read_as: ReadAs) -> Result<Shape> {
-        Shape::from_raw(crate::shape::io::read_shape(path)?, read_as)
+        Shape::read_with(path, read_as, &Repairs::default())
     }
 
-    fn build(vertices: Vec<[f64; 3]>, polygons: &[&[u32]], kind: ShapeKind) -> Result<Shape> {
+    /// [`Shape::read`] with the given repairs.
+    pub fn read_with(path: &std::path::Path, read_as: ReadAs, repairs: &Repairs) -> Result<Shape> {
+        Shape::from_raw_with(crate::shape::io::read_shape(path)?, read_as, repairs)
+    }
+
+    fn build(
+        vertices: Vec<[f64; 3]>,
+        polygons: &[&[u32]],
+        kind: ShapeKind,
+        repairs: &Repairs,
+    ) -> Result<Shape> {
         for (i, v) in vertices.iter().enumerate() {
             if let Some(&value) = v.iter().find(|c| !c.is_finite()) {
                 return Err(Error::NonFiniteCoordinate { vertex: i, value });
@@ -208,29 +296,9 @@ impl Shape {
             });
         }
         let mut warnings = Vec::new();
-        let (triangles, active) = match kind {
-            ShapeKind::Mesh => {
-                let triangles = clean_faces(&vertices, polygons, &mut warnings)?;
-                if triangles.is_empty() {
-                    return Err(Error::ZeroArea {
-                        detail: if polygons.is_empty() {
-                            "the mesh has no faces; read vertices without faces as a point cloud"
-                                .to_string()
-                        } else {
-                            format!("all {} faces repeat a corner", polygons.len())
-                        },
-                    });
-                }
-                let mut used = vec![false; n];
-                for t in &triangles {
-                    for &v in t {
-                        used[v as usize] = true;
-                    }
-                }
-                let active: Vec<u32> = (0..n as u32).filter(|&v| used[v as usize]).collect();
-                (triangles, active)
-            }
-            ShapeKind::PointCloud => (Vec::new(), (0..n as u32).collect()),
+        let (triangles, active, welded_to) = match kind {
+            ShapeKind::Mesh => Shape::repaired_mesh(&vertices, polygons, repairs, &mut warnings)?,
+            ShapeKind::PointCloud => Shape::repaired_cloud(&vertices, repairs, &mut warnings),
         };
         if active.len() < MIN_VERTICES {
             return Err(Error::TooFewVertices {
@@ -238,11 +306,12 @@ impl Shape {
                 required: MIN_VERTICES,
             });
         }
-        let representative = representatives(&vertices, &active);
-        if active.len() < n {
-            warnings.push(Warning::UnreferencedVertices {
-                count: n - active.len(),
-            });
+        let mut representative = representatives(&vertices, &active);
+        for (v, rep) in representative.iter_mut().enumerate() {
+            let root = welded_to[v];
+            if root as usize != v && representative_is_active(&active, root) {
+                *rep = root;
+            }
         }
         let mut shape = Shape {
             vertices,
@@ -270,7 +339,12 @@ impl Shape {
                 shape.check_edges();
             }
             ShapeKind::PointCloud => {
-                let extent = bounding_box_diagonal(&shape.vertices);
+                let active_points: Vec<[f64; 3]> = shape
+                    .active
+                    .iter()
+                    .map(|&v| shape.vertices[v as usize])
+                    .collect();
+                let extent = bounding_box_diagonal(&active_points);
                 if !(extent > 0.0) {
                     return Err(Error::ZeroArea {
                         detail: format!("all {} points coincide", shape.vertices.len()),
@@ -285,6 +359,160 @@ impl Shape {
             });
         }
         Ok(shape)
+    }
+
+    /// A mesh's cleaned triangles, its active vertices and every vertex's weld target, after
+    /// the [`Repairs`]: far vertices and their faces dropped, coincident vertices welded,
+    /// faces cleaned, small pieces dropped.
+    fn repaired_mesh(
+        vertices: &[[f64; 3]],
+        polygons: &[&[u32]],
+        repairs: &Repairs,
+        warnings: &mut Vec<Warning>,
+    ) -> Result<(Vec<[u32; 3]>, Vec<u32>, Vec<u32>)> {
+        let n = vertices.len();
+        // Indices are checked before anything looks at them.
+        let mut triangles = clean_faces(vertices, polygons, warnings)?;
+        if triangles.is_empty() {
+            return Err(Error::ZeroArea {
+                detail: if polygons.is_empty() {
+                    "the mesh has no faces; read vertices without faces as a point cloud"
+                        .to_string()
+                } else {
+                    format!("all {} faces repeat a corner", polygons.len())
+                },
+            });
+        }
+        let used_by = |triangles: &[[u32; 3]]| -> Vec<u32> {
+            let mut used = vec![false; n];
+            for t in triangles {
+                for &v in t {
+                    used[v as usize] = true;
+                }
+            }
+            (0..n as u32).filter(|&v| used[v as usize]).collect()
+        };
+        let referenced = used_by(&triangles);
+        let mut dropped = vec![false; n];
+        if repairs.outliers {
+            let far = repair::far_vertices(vertices, &referenced);
+            if !far.is_empty() && far.len() < referenced.len() {
+                for &v in &far {
+                    dropped[v as usize] = true;
+                }
+                triangles.retain(|t| !t.iter().any(|&v| dropped[v as usize]));
+                warnings.push(Warning::FarVerticesDropped { count: far.len() });
+            }
+        }
+        let kept = used_by(&triangles);
+        let size = repair::robust_size(vertices, &kept);
+        let welded_to = repair::weld(vertices, &kept, repairs.weld_tolerance * size);
+        let welded = kept.iter().filter(|&&v| welded_to[v as usize] != v).count();
+        if welded > 0 {
+            for t in &mut triangles {
+                *t = t.map(|v| welded_to[v as usize]);
+            }
+            let before = triangles.len();
+            triangles.retain(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
+            let mut seen = std::collections::HashSet::with_capacity(triangles.len());
+            triangles.retain(|t| {
+                let mut key = *t;
+                key.sort_unstable();
+                seen.insert(key)
+            });
+            warnings.push(Warning::VerticesWelded { count: welded });
+            if triangles.len() < before {
+                warnings.push(Warning::DegenerateFacesDropped {
+                    count: before - triangles.len(),
+                });
+            }
+        }
+        let keep = repair::keep_large_pieces(vertices, &triangles, repairs.debris_fraction);
+        if keep.iter().any(|&k| !k) {
+            let before = used_by(&triangles).len();
+            let mut pieces = DisjointSets::new(n);
+            let small: Vec<[u32; 3]> = triangles
+                .iter()
+                .zip(&keep)
+                .filter(|(_, &k)| !k)
+                .map(|(t, _)| *t)
+                .collect();
+            for t in &small {
+                pieces.union(t[0] as usize, t[1] as usize);
+                pieces.union(t[1] as usize, t[2] as usize);
+            }
+            let mut roots: Vec<usize> = small.iter().map(|t| pieces.find(t[0] as usize)).collect();
+            roots.sort_unstable();
+            roots.dedup();
+            let mut k = keep.iter();
+            triangles.retain(|_| *k.next().unwrap_or(&true));
+            warnings.push(Warning::SmallPiecesDropped {
+                pieces: roots.len(),
+                vertices: before - used_by(&triangles).len(),
+            });
+        }
+        let active = used_by(&triangles);
+        let unreferenced = n - referenced.len();
+        if unreferenced > 0 {
+            warnings.push(Warning::UnreferencedVertices {
+                count: unreferenced,
+            });
+        }
+        Ok((triangles, active, welded_to))
+    }
+
+    /// A point cloud's active points and every point's weld target, after the [`Repairs`]:
+    /// far points dropped, coincident points welded, isolated points and small pieces of the
+    /// neighbour graph dropped.
+    fn repaired_cloud(
+        vertices: &[[f64; 3]],
+        repairs: &Repairs,
+        warnings: &mut Vec<Warning>,
+    ) -> (Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
+        let all: Vec<u32> = (0..vertices.len() as u32).collect();
+        let mut active = all.clone();
+        if repairs.outliers {
+            let far = repair::far_vertices(vertices, &all);
+            if !far.is_empty() {
+                let mut is_far = vec![false; vertices.len()];
+                for &v in &far {
+                    is_far[v as usize] = true;
+                }
+                active.retain(|&v| !is_far[v as usize]);
+                warnings.push(Warning::FarVerticesDropped { count: far.len() });
+            }
+        }
+        let size = repair::robust_size(vertices, &active);
+        let welded_to = repair::weld(vertices, &active, repairs.weld_tolerance * size);
+        let before = active.len();
+        active.retain(|&v| welded_to[v as usize] == v);
+        if active.len() < before {
+            warnings.push(Warning::VerticesWelded {
+                count: before - active.len(),
+            });
+        }
+        if repairs.outliers && active.len() >= MIN_VERTICES {
+            let before = active.len();
+            active = repair::dense_points(vertices, &active);
+            if active.len() < before {
+                warnings.push(Warning::OutlierPointsDropped {
+                    count: before - active.len(),
+                });
+            }
+        }
+        if active.len() >= MIN_VERTICES {
+            let before = active.len();
+            let (kept, pieces) =
+                repair::keep_large_cloud_pieces(vertices, &active, repairs.debris_fraction);
+            if pieces > 0 {
+                warnings.push(Warning::SmallPiecesDropped {
+                    pieces,
+                    vertices: before - kept.len(),
+                });
+                active = kept;
+            }
+        }
+        (Vec::new(), active, welded_to)
     }
 
     /// Vertex positions in the caller's order and units.
@@ -337,9 +565,14 @@ impl Shape {
             .sum()
     }
 
-    /// Length of the bounding-box diagonal, the "width" of the shape.
+    /// Length of the bounding-box diagonal of the active vertices, the "width" of the shape.
     pub fn width(&self) -> f64 {
-        bounding_box_diagonal(&self.vertices)
+        let active: Vec<[f64; 3]> = self
+            .active
+            .iter()
+            .map(|&v| self.vertices[v as usize])
+            .collect();
+        bounding_box_diagonal(&active)
     }
 
     /// Undirected edges between active vertices, each once as (low, high), sorted: mesh edges,
@@ -352,15 +585,23 @@ impl Shape {
                 .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
                 .map(|(a, b)| (a.min(b), a.max(b)))
                 .collect(),
-            ShapeKind::PointCloud => symmetric_knn_graph(&self.vertices, POINT_CLOUD_GRAPH_K)
-                .into_iter()
-                .enumerate()
-                .flat_map(|(i, list)| {
-                    list.into_iter()
-                        .filter(move |&j| j > i)
-                        .map(move |j| (i as u32, j as u32))
-                })
-                .collect(),
+            ShapeKind::PointCloud => {
+                let points: Vec<[f64; 3]> = self
+                    .active
+                    .iter()
+                    .map(|&v| self.vertices[v as usize])
+                    .collect();
+                let active = &self.active;
+                symmetric_knn_graph(&points, POINT_CLOUD_GRAPH_K)
+                    .into_iter()
+                    .enumerate()
+                    .flat_map(|(i, list)| {
+                        list.into_iter()
+                            .filter(move |&j| j > i)
+                            .map(move |j| (active[i], active[j]))
+                    })
+                    .collect()
+            }
         };
         edges.sort_unstable();
         edges.dedup();
@@ -595,6 +836,11 @@ fn triangulate(vertices: &[[f64; 3]], polygon: &[u32], out: &mut Vec<[u32; 3]>) 
             }
         }
     }
+}
+
+/// Whether `v` is in the ascending list `active`.
+fn representative_is_active(active: &[u32], v: u32) -> bool {
+    active.binary_search(&v).is_ok()
 }
 
 /// For every vertex, itself if active, else the nearest active vertex.

@@ -206,6 +206,53 @@ static void test_shape_errors(void) {
     sc_shape_free(NULL);
 }
 
+/* A triangle soup (every face with its own corners, as unwelded exports write it) is
+ * welded by default and kept as given with SC_REPAIR_NONE; every vertex keeps its index. */
+static void test_repairs(void) {
+    sc_shape *figure_shape = figure("humanoid", 0);
+    size_t n = sc_shape_n_vertices(figure_shape), m = sc_shape_n_triangles(figure_shape), i;
+    double *xyz = malloc(3 * n * sizeof *xyz), *soup = malloc(9 * m * sizeof *soup);
+    uint32_t *triangles = malloc(3 * m * sizeof *triangles);
+    uint32_t *soup_triangles = malloc(3 * m * sizeof *soup_triangles);
+    char warnings[4096];
+    sc_shape *welded = NULL, *as_given = NULL, *bad = NULL;
+    CHECK(xyz && soup && triangles && soup_triangles, "allocation");
+    CHECK_STATUS(sc_shape_vertices(figure_shape, xyz, 3 * n), SC_STATUS_OK);
+    CHECK_STATUS(sc_shape_triangles(figure_shape, triangles, 3 * m), SC_STATUS_OK);
+    for (i = 0; i < 3 * m; i++) {
+        memcpy(&soup[3 * i], &xyz[3 * triangles[i]], 3 * sizeof *soup);
+        soup_triangles[i] = (uint32_t)i;
+    }
+    CHECK_STATUS(sc_shape_new_mesh(soup, 3 * m, soup_triangles, m, &welded), SC_STATUS_OK);
+    CHECK(sc_shape_n_vertices(welded) == 3 * m, "every input vertex kept its index");
+    sc_shape_warnings(welded, warnings, sizeof warnings);
+    CHECK(strstr(warnings, "welded") != NULL, "the weld is reported: %s", warnings);
+    CHECK(strstr(warnings, "disconnected") == NULL, "one piece after welding: %s", warnings);
+    CHECK(sc_shape_repairs(welded, warnings, sizeof warnings) > 0, "a repair was made");
+    CHECK(strstr(warnings, "welded") != NULL, "the weld is a repair: %s", warnings);
+    CHECK_STATUS(sc_shape_new_mesh_repaired(soup, 3 * m, soup_triangles, m, SC_REPAIR_NONE,
+                                            &as_given),
+                 SC_STATUS_OK);
+    sc_shape_warnings(as_given, warnings, sizeof warnings);
+    CHECK(strstr(warnings, "welded") == NULL, "no weld asked for: %s", warnings);
+    CHECK(strstr(warnings, "disconnected") != NULL, "the soup stays in pieces: %s", warnings);
+    CHECK(sc_shape_repairs(as_given, warnings, sizeof warnings) == 0, "no repair: %s", warnings);
+    CHECK_STATUS(sc_shape_new_mesh_repaired(soup, 3 * m, soup_triangles, m, 8, &bad),
+                 SC_STATUS_INVALID_ARGUMENT);
+    CHECK(bad == NULL, "no shape from unknown repair flags");
+    CHECK_STATUS(sc_shape_new_point_cloud_repaired(xyz, n, SC_REPAIR_ALL, &bad), SC_STATUS_OK);
+    sc_shape_free(bad);
+    CHECK_STATUS(sc_shape_read_repaired("/nonexistent/shape.ply", false, SC_REPAIR_NONE, &bad),
+                 SC_STATUS_FILE_ERROR);
+    sc_shape_free(welded);
+    sc_shape_free(as_given);
+    sc_shape_free(figure_shape);
+    free(xyz);
+    free(soup);
+    free(triangles);
+    free(soup_triangles);
+}
+
 /* ----------------------------------------------------------------------- life cycle */
 
 struct progress_log {
@@ -922,6 +969,7 @@ int main(void) {
     test_status_text();
     test_options();
     test_shape_errors();
+    test_repairs();
     test_match_errors();
     test_life_cycle();
     test_point_cloud();

@@ -114,11 +114,20 @@ class Shape(_Handle):
     _free = lib.sc_shape_free
 
     @classmethod
-    def mesh(cls, vertices, triangles):
+    def mesh(cls, vertices, triangles, repair=True):
         """A mesh from an (n, 3) array of vertices and an (m, 3) array of 0-based triangle
-        indices (copied; float32 coordinates stay float32 on the way in)."""
+        indices (copied; float32 coordinates stay float32 on the way in).
+
+        ``repair``: ``True`` (the default) welds coincident vertices (UV seams, triangle
+        soups) and leaves out small loose pieces and far vertices; ``False`` uses the mesh as
+        given; or a collection of ``"weld"``, ``"debris"``, ``"outliers"``. Every vertex
+        keeps its index; the repairs made are in :attr:`warnings`."""
         vertices = np.asarray(vertices)
+        flags = _repair_flags(repair)
         coords, function, ctype = _coordinates(vertices, lib.sc_shape_new_mesh_f32, lib.sc_shape_new_mesh)
+        if flags != _REPAIR_ALL:
+            coords, ctype = np.ascontiguousarray(coords, dtype=np.float64), ctypes.c_double
+            function = functools.partial(_with_flags, lib.sc_shape_new_mesh_repaired, 4, flags)
         tris = np.asarray(triangles)
         if tris.size and (tris.ndim != 2 or tris.shape[1] != 3):
             raise ValueError(f"triangles must have shape (m, 3), got {tris.shape}")
@@ -135,17 +144,29 @@ class Shape(_Handle):
         )
 
     @classmethod
-    def point_cloud(cls, points):
-        """A point cloud from an (n, 3) array of points (copied)."""
+    def point_cloud(cls, points, repair=True):
+        """A point cloud from an (n, 3) array of points (copied). ``repair`` as for
+        :meth:`mesh` (coincident points welded, far and isolated points and small loose
+        clusters left out)."""
+        flags = _repair_flags(repair)
         coords, function, ctype = _coordinates(
             np.asarray(points), lib.sc_shape_new_point_cloud_f32, lib.sc_shape_new_point_cloud
         )
+        if flags != _REPAIR_ALL:
+            coords, ctype = np.ascontiguousarray(coords, dtype=np.float64), ctypes.c_double
+            function = functools.partial(_with_flags, lib.sc_shape_new_point_cloud_repaired, 2, flags)
         return cls(_new_handle(function, _ptr(coords, ctype), len(coords)))
 
     @classmethod
-    def read(cls, path, as_point_cloud=False):
-        """Reads OFF, OBJ, PLY or XYZ; a file without faces gives a point cloud."""
-        return cls(_new_handle(lib.sc_shape_read, str(path).encode(), bool(as_point_cloud)))
+    def read(cls, path, as_point_cloud=False, repair=True):
+        """Reads OFF, OBJ, PLY or XYZ; a file without faces gives a point cloud. ``repair``
+        as for :meth:`mesh`."""
+        return cls(
+            _new_handle(
+                lib.sc_shape_read_repaired, str(path).encode(), bool(as_point_cloud),
+                _repair_flags(repair),
+            )
+        )
 
     @classmethod
     def figure(cls, kind="humanoid", pose=0, vertices=5000):
@@ -178,14 +199,57 @@ class Shape(_Handle):
     @property
     def warnings(self):
         """What was repaired or is unusual (degenerate faces, pieces, ...), one string each."""
-        n = lib.sc_shape_warnings(self, None, 0)
-        buf = ctypes.create_string_buffer(n + 1)
-        lib.sc_shape_warnings(self, buf, n + 1)
-        return [line for line in buf.value.decode().split("\n") if line]
+        return _lines(lib.sc_shape_warnings, self)
+
+    @property
+    def repairs(self):
+        """The repairs made (coincident vertices welded, debris, far vertices or isolated
+        points left out; see ``repair`` of :meth:`mesh`), one string each: a part of
+        :attr:`warnings`."""
+        return _lines(lib.sc_shape_repairs, self)
 
     def __repr__(self):
         kind = "point cloud" if self.is_point_cloud else "mesh"
         return f"<shapecorr.Shape {kind}, {self.n_vertices} vertices>"
+
+
+def _lines(function, shape):
+    """The lines of a text a ``sc_shape_*`` function writes as ``snprintf`` does."""
+    n = function(shape, None, 0)
+    buf = ctypes.create_string_buffer(n + 1)
+    function(shape, buf, n + 1)
+    return [line for line in buf.value.decode().split("\n") if line]
+
+
+#: The repairs by name (the C API's ``SC_REPAIR_*`` flags).
+REPAIRS = {"weld": 1, "debris": 2, "outliers": 4}
+_REPAIR_ALL = 7
+
+
+def _repair_flags(repair):
+    """The C flags of a ``repair`` argument: True (all), False (none) or a collection of
+    names from :data:`REPAIRS`."""
+    if repair is True:
+        return _REPAIR_ALL
+    if repair is False or repair is None:
+        return 0
+    if isinstance(repair, (str, bytes)) or not hasattr(repair, "__iter__"):
+        raise TypeError(
+            f"repair must be True, False or a collection of {sorted(REPAIRS)}, got {repair!r}"
+        )
+    flags = 0
+    for name in repair:
+        if name not in REPAIRS:
+            raise ValueError(f"unknown repair {name!r}; the repairs are {sorted(REPAIRS)}")
+        flags |= REPAIRS[name]
+    return flags
+
+
+def _with_flags(function, position, flags, *args):
+    """Calls a ``*_repaired`` constructor with ``flags`` inserted at ``position``."""
+    args = list(args)
+    args.insert(position, flags)
+    return function(*args)
 
 
 def _coordinates(array, f32_function, f64_function):

@@ -85,6 +85,9 @@ FUNCTIONS = {
     "sc_shape_new_point_cloud_f32": (status, [c_f32p, c_size_t, handle_out]),
     "sc_shape_read": (status, [c_str, ctypes.c_bool, handle_out]),
     "sc_shape_new_figure": (status, [c_str, c_u32, c_u32, handle_out]),
+    "sc_shape_new_mesh_repaired": (status, [c_f64p, c_size_t, c_u32p, c_size_t, c_u32, handle_out]),
+    "sc_shape_new_point_cloud_repaired": (status, [c_f64p, c_size_t, c_u32, handle_out]),
+    "sc_shape_read_repaired": (status, [c_str, ctypes.c_bool, c_u32, handle_out]),
     "sc_shape_free": (None, [handle]),
     "sc_shape_n_vertices": (c_size_t, [handle]),
     "sc_shape_n_triangles": (c_size_t, [handle]),
@@ -92,6 +95,7 @@ FUNCTIONS = {
     "sc_shape_vertices": (status, [handle, c_f64p, c_size_t]),
     "sc_shape_triangles": (status, [handle, c_u32p, c_size_t]),
     "sc_shape_warnings": (c_size_t, [handle, ctypes.c_char_p, c_size_t]),
+    "sc_shape_repairs": (c_size_t, [handle, ctypes.c_char_p, c_size_t]),
     # parameters
     "sc_params_new": (status, [handle_out]),
     "sc_params_free": (None, [handle]),

@@ -494,3 +494,37 @@ def _check_seconds(result, stage):
     value = ctypes.c_double()
     shapecorr._check(_lib.lib.sc_pointwise_seconds(result, stage.encode(), ctypes.byref(value)))
     return value.value
+
+
+def test_a_triangle_soup_is_welded_unless_repair_is_off():
+    figure = shapecorr.Shape.figure("humanoid", 0, 1500)
+    corners = figure.triangles.reshape(-1)
+    soup_vertices = figure.vertices[corners]
+    soup_triangles = np.arange(len(corners), dtype=np.uint32).reshape(-1, 3)
+    welded = shapecorr.Shape.mesh(soup_vertices, soup_triangles)
+    assert welded.n_vertices == len(corners)
+    assert any("welded" in w for w in welded.warnings), welded.warnings
+    assert welded.repairs == [w for w in welded.warnings if "welded" in w]
+    as_given = shapecorr.Shape.mesh(soup_vertices, soup_triangles, repair=False)
+    assert not any("welded" in w for w in as_given.warnings)
+    assert as_given.repairs == []
+    assert any("disconnected" in w for w in as_given.warnings), as_given.warnings
+    only_debris = shapecorr.Shape.mesh(soup_vertices.astype(np.float32), soup_triangles, repair={"debris"})
+    assert not any("welded" in w for w in only_debris.warnings)
+    # Welded duplicates share one answer: the regions of every corner of a vertex agree.
+    result = shapecorr.match(welded, shapecorr.Shape.figure("humanoid", 3, 1500))
+    regions = result.regions("a")
+    by_vertex = {}
+    for corner, vertex in enumerate(corners):
+        by_vertex.setdefault(int(vertex), set()).add(int(regions[corner]))
+    assert all(len(labels) == 1 for labels in by_vertex.values())
+
+
+def test_bad_repair_arguments_raise():
+    points = shapecorr.Shape.figure("humanoid", 0, 1000).vertices
+    with pytest.raises(TypeError):
+        shapecorr.Shape.point_cloud(points, repair="weld")
+    with pytest.raises(ValueError, match="unknown repair"):
+        shapecorr.Shape.point_cloud(points, repair={"glue"})
+    cloud = shapecorr.Shape.point_cloud(np.vstack([points, [[1e3, 1e3, 1e3]]]), repair={"outliers"})
+    assert any("far from" in w for w in cloud.warnings), cloud.warnings

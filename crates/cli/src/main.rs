@@ -5,6 +5,7 @@
 //! library's option table (`options.rs`); the files every command writes are `output.rs`'s.
 
 mod commands;
+mod input;
 mod options;
 mod output;
 

@@ -1,12 +1,12 @@
 //! `shapecorr eigen`: Laplacian eigenvalues of a shape, with time and peak memory.
 
+use crate::input::read_shape;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde_json::json;
 use shapecorr::spectral::laplacian::Laplacian;
-use shapecorr::ReadAs;
-use shapecorr::{EigenParams, Error, Shape};
+use shapecorr::{EigenParams, Error};
 
 #[derive(clap::Args)]
 pub struct EigenArgs {
@@ -16,6 +16,10 @@ pub struct EigenArgs {
     k: usize,
     #[arg(long)]
     points: bool,
+    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
+    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
+    #[arg(long)]
+    no_repair: bool,
     #[arg(long)]
     json: bool,
     /// Threads for dense products (0 = all); the result does not depend on it.
@@ -32,7 +36,7 @@ impl EigenArgs {
     pub fn run(&self) -> Result<(), Error> {
         let file = &self.file;
         let t0 = Instant::now();
-        let shape = Shape::read(file, ReadAs::point_cloud_when(self.points))?;
+        let shape = read_shape(file, self.points, self.no_repair, None)?;
         let t_read = t0.elapsed().as_secs_f64();
         let params = EigenParams {
             n_eigenpairs: self.k,

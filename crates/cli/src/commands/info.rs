@@ -1,11 +1,11 @@
 //! `shapecorr info`: counts, area, pieces and warnings of a shape file.
 
+use crate::input::read_shape;
 use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::spectral::laplacian::Laplacian;
-use shapecorr::ReadAs;
-use shapecorr::{Error, Shape, ShapeKind};
+use shapecorr::{Error, ShapeKind};
 
 #[derive(clap::Args)]
 pub struct InfoArgs {
@@ -13,6 +13,10 @@ pub struct InfoArgs {
     /// Treat the file as a point cloud even if it has faces.
     #[arg(long)]
     points: bool,
+    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
+    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
+    #[arg(long)]
+    no_repair: bool,
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
@@ -21,7 +25,7 @@ pub struct InfoArgs {
 impl InfoArgs {
     pub fn run(&self) -> Result<(), Error> {
         let file = &self.file;
-        let shape = Shape::read(file, ReadAs::point_cloud_when(self.points))?;
+        let shape = read_shape(file, self.points, self.no_repair, None)?;
         let laplacian = Laplacian::new(&shape)?;
         let warnings: Vec<String> = shape.warnings().iter().map(|w| w.to_string()).collect();
         let kind = match shape.kind() {

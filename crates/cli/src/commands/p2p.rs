@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::maps::pointwise::PointwiseCorrespondence;
-use shapecorr::ReadAs;
-use shapecorr::{Error, Shape};
+use shapecorr::Error;
 
+use crate::input::read_shape;
 use crate::options::PointwiseOptions;
 use crate::output::{
     confidence_summary, correspondence_json, create_dir, end_progress_line, options_json,
@@ -23,6 +23,10 @@ pub struct P2pArgs {
     out: PathBuf,
     #[arg(long)]
     points: bool,
+    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
+    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
+    #[arg(long)]
+    no_repair: bool,
     #[command(flatten)]
     options: PointwiseOptions,
 }
@@ -30,8 +34,8 @@ pub struct P2pArgs {
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let shape_a = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
-        let shape_b = Shape::read(&self.b, ReadAs::point_cloud_when(self.points))?;
+        let shape_a = read_shape(&self.a, self.points, self.no_repair, Some("A"))?;
+        let shape_b = read_shape(&self.b, self.points, self.no_repair, Some("B"))?;
         let out = &self.out;
         create_dir(out)?;
         let result = PointwiseCorrespondence::compute(

@@ -5,9 +5,9 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::correspondence::{Correspondence, Symmetry};
-use shapecorr::ReadAs;
-use shapecorr::{Error, Shape};
+use shapecorr::Error;
 
+use crate::input::read_shape;
 use crate::options::RegionOptions;
 use crate::output::{
     confidence_summary, correspondence_json, create_dir, end_progress_line, graph_json,
@@ -24,6 +24,10 @@ pub struct MatchArgs {
     /// Treat both files as point clouds even if they have faces.
     #[arg(long)]
     points: bool,
+    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
+    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
+    #[arg(long)]
+    no_repair: bool,
     #[command(flatten)]
     options: RegionOptions,
 }
@@ -31,8 +35,8 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape_a = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
-        let shape_b = Shape::read(&self.b, ReadAs::point_cloud_when(self.points))?;
+        let shape_a = read_shape(&self.a, self.points, self.no_repair, Some("A"))?;
+        let shape_b = read_shape(&self.b, self.points, self.no_repair, Some("B"))?;
         let out = &self.out;
         create_dir(out)?;
         let result =
@@ -67,6 +71,10 @@ pub struct SymmetryArgs {
     out: PathBuf,
     #[arg(long)]
     points: bool,
+    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
+    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
+    #[arg(long)]
+    no_repair: bool,
     #[command(flatten)]
     options: RegionOptions,
 }
@@ -74,7 +82,7 @@ pub struct SymmetryArgs {
 impl SymmetryArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
+        let shape = read_shape(&self.a, self.points, self.no_repair, Some("A"))?;
         let out = &self.out;
         create_dir(out)?;
         let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress);

@@ -1,0 +1,271 @@
+//! Repairs of what real files contain (issue 19): vertices split along UV seams or never
+//! welded (triangle soups), scan debris (small loose pieces), far vertices and outlier points.
+//!
+//! Every repair keeps the caller's vertex order: a repaired-away vertex becomes inactive and
+//! takes the values of an active one ([`super::Shape::representative`]): a welded duplicate
+//! those of the vertex it was welded to, a dropped one those of the nearest kept vertex. Each
+//! repair is reported as a [`super::Warning`] and can be switched off ([`Repairs`]).
+//! Tolerances measured on every shape of `../shared/data` (docs/decisions.md, "Repairs").
+
+use std::collections::HashMap;
+
+use super::neighbors::PointTree;
+use super::{distance, DisjointSets};
+
+/// Which repairs [`super::Shape`] construction makes, and their tolerances.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Repairs {
+    /// Vertices closer than this fraction of the shape's size ([`robust_size`]) are welded
+    /// into one; 0 switches welding off. Exporters write seam duplicates bit-identical or
+    /// within float rounding (1e-7 of the size); no shape of the benchmarks has two distinct
+    /// vertices within 1e-6 of its size.
+    pub weld_tolerance: f64,
+    /// Connected pieces holding less than this fraction of the area (a point cloud: of the
+    /// points) are dropped as debris, when a larger piece remains; 0 switches it off.
+    pub debris_fraction: f64,
+    /// Drop far vertices (beyond [`FAR_FACTOR`] times the shape's robust radius) and, in a
+    /// point cloud, isolated points (local-density test, [`OUTLIER_SPACING_FACTOR`]).
+    pub outliers: bool,
+}
+
+impl Default for Repairs {
+    fn default() -> Self {
+        Repairs {
+            weld_tolerance: 1e-6,
+            debris_fraction: 0.01,
+            outliers: true,
+        }
+    }
+}
+
+impl Repairs {
+    /// No repair at all: the shape is used as given.
+    pub fn none() -> Repairs {
+        Repairs {
+            weld_tolerance: 0.0,
+            debris_fraction: 0.0,
+            outliers: false,
+        }
+    }
+}
+
+/// A vertex farther from the shape's centre than this many robust radii is dropped.
+pub const FAR_FACTOR: f64 = 10.0;
+
+/// Quantile of the distances to the centre that defines the robust radius.
+const RADIUS_QUANTILE: f64 = 0.95;
+
+/// A point whose distance to its [`OUTLIER_NEIGHBOUR`]-th nearest neighbour exceeds this many
+/// times the median of that distance is an outlier.
+pub const OUTLIER_SPACING_FACTOR: f64 = 8.0;
+
+/// The neighbour the local-density test measures the distance to.
+const OUTLIER_NEIGHBOUR: usize = 6;
+
+/// The coordinate-wise median of `points` (of those listed in `of`) and the
+/// [`RADIUS_QUANTILE`] quantile of their distances to it: a centre and a radius that a few
+/// far vertices cannot move.
+pub fn robust_centre_and_radius(points: &[[f64; 3]], of: &[u32]) -> ([f64; 3], f64) {
+    let centre: [f64; 3] =
+        std::array::from_fn(|c| median(of.iter().map(|&v| points[v as usize][c]).collect()));
+    let mut radii: Vec<f64> = of
+        .iter()
+        .map(|&v| distance(&points[v as usize], &centre))
+        .collect();
+    radii.sort_by(f64::total_cmp);
+    let at = ((radii.len() as f64 * RADIUS_QUANTILE) as usize).min(radii.len() - 1);
+    (centre, radii[at])
+}
+
+/// Twice the robust radius: the size tolerances are relative to.
+pub fn robust_size(points: &[[f64; 3]], of: &[u32]) -> f64 {
+    2.0 * robust_centre_and_radius(points, of).1
+}
+
+/// Of the vertices `of`, those beyond [`FAR_FACTOR`] robust radii from the robust centre.
+pub fn far_vertices(points: &[[f64; 3]], of: &[u32]) -> Vec<u32> {
+    let (centre, radius) = robust_centre_and_radius(points, of);
+    of.iter()
+        .copied()
+        .filter(|&v| distance(&points[v as usize], &centre) > FAR_FACTOR * radius)
+        .collect()
+}
+
+/// For every vertex, the vertex it is welded to: the lowest index among the vertices of
+/// `of` chained to it by distances at most `tolerance` (itself when none; vertices not in
+/// `of` are left alone). Found on a grid of cells of the tolerance's size.
+pub fn weld(points: &[[f64; 3]], of: &[u32], tolerance: f64) -> Vec<u32> {
+    let mut root: Vec<u32> = (0..points.len() as u32).collect();
+    if !(tolerance > 0.0) || of.is_empty() {
+        return root;
+    }
+    let (centre, _) = robust_centre_and_radius(points, of);
+    let cell = |p: &[f64; 3]| -> [i64; 3] {
+        std::array::from_fn(|c| ((p[c] - centre[c]) / tolerance).floor() as i64)
+    };
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(of.len());
+    for &v in of {
+        grid.entry(cell(&points[v as usize])).or_default().push(v);
+    }
+    let mut sets = DisjointSets::new(points.len());
+    for &v in of {
+        let p = &points[v as usize];
+        let [x, y, z] = cell(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(others) = grid.get(&[x + dx, y + dy, z + dz]) else {
+                        continue;
+                    };
+                    for &w in others {
+                        if w > v && distance(p, &points[w as usize]) <= tolerance {
+                            sets.union(v as usize, w as usize);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for &v in of {
+        root[v as usize] = sets.find(v as usize) as u32;
+    }
+    root
+}
+
+/// The triangles to keep: those of every connected piece holding at least `fraction` of the
+/// total area, when at least one piece does (else all of them).
+pub fn keep_large_pieces(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    fraction: f64,
+) -> Vec<bool> {
+    let mut sets = DisjointSets::new(vertices.len());
+    for t in triangles {
+        sets.union(t[0] as usize, t[1] as usize);
+        sets.union(t[1] as usize, t[2] as usize);
+    }
+    let mut area_of: HashMap<usize, f64> = HashMap::new();
+    let roots: Vec<usize> = triangles.iter().map(|t| sets.find(t[0] as usize)).collect();
+    let mut total = 0.0;
+    for (t, &r) in triangles.iter().zip(&roots) {
+        let area = super::triangle_area(vertices, t);
+        *area_of.entry(r).or_default() += area;
+        total += area;
+    }
+    let large = |r: &usize| area_of[r] >= fraction * total;
+    if !(fraction > 0.0) || !area_of.keys().any(large) {
+        return vec![true; triangles.len()];
+    }
+    roots.iter().map(large).collect()
+}
+
+/// Two points of a cloud are in one piece when a chain of points joins them, each step at
+/// most this many times the larger of its two ends' spacings ([`CloudNeighbourhoods`]).
+/// Relative to each point's own spacing, because the benchmarks' vertex sets vary in
+/// density by 10x and more (TOSCA's david): a global spacing split 9,000 of david's 52,565
+/// vertices off as "debris", and the k-nearest-neighbour graph itself splits the dense
+/// patches of FAUST's vertices off as pieces of 30 to 60 points.
+pub const PIECE_LINK_SPACINGS: f64 = 5.0;
+
+/// Nearest neighbours looked at for the links of [`PIECE_LINK_SPACINGS`].
+const LINK_NEIGHBOURS: usize = 32;
+
+/// Every point's nearest neighbours and its spacing (the distance to its
+/// [`OUTLIER_NEIGHBOUR`]-th nearest other point), for the point-cloud repairs.
+struct CloudNeighbourhoods {
+    /// Per point (position in `of`): its [`LINK_NEIGHBOURS`] nearest others, with distances.
+    near: Vec<Vec<(usize, f64)>>,
+    spacing: Vec<f64>,
+}
+
+impl CloudNeighbourhoods {
+    fn new(points: &[[f64; 3]], of: &[u32]) -> Self {
+        let subset: Vec<[f64; 3]> = of.iter().map(|&v| points[v as usize]).collect();
+        let tree = PointTree::new(&subset);
+        // nearest_k returns squared distances and includes the point itself.
+        let near: Vec<Vec<(usize, f64)>> = subset
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                tree.nearest_k(p, LINK_NEIGHBOURS + 1)
+                    .into_iter()
+                    .filter(|&(j, _)| j != i)
+                    .map(|(j, d2)| (j, d2.sqrt()))
+                    .collect()
+            })
+            .collect();
+        let spacing = near
+            .iter()
+            .map(|list| list.get(OUTLIER_NEIGHBOUR - 1).map_or(0.0, |&(_, d)| d))
+            .collect();
+        CloudNeighbourhoods { near, spacing }
+    }
+}
+
+/// Of a point cloud's points `of`, those in pieces ([`PIECE_LINK_SPACINGS`]) holding at least
+/// `fraction` of the points (all of them when no piece does), and the number of pieces
+/// left out.
+pub fn keep_large_cloud_pieces(
+    points: &[[f64; 3]],
+    of: &[u32],
+    fraction: f64,
+) -> (Vec<u32>, usize) {
+    if !(fraction > 0.0) || of.len() <= LINK_NEIGHBOURS {
+        return (of.to_vec(), 0);
+    }
+    let hood = CloudNeighbourhoods::new(points, of);
+    let mut sets = DisjointSets::new(of.len());
+    for (i, list) in hood.near.iter().enumerate() {
+        for &(j, d) in list {
+            if d <= PIECE_LINK_SPACINGS * hood.spacing[i].max(hood.spacing[j]) {
+                sets.union(i, j);
+            }
+        }
+    }
+    let root: Vec<usize> = (0..of.len()).map(|i| sets.find(i)).collect();
+    let mut count: HashMap<usize, usize> = HashMap::new();
+    for &r in &root {
+        *count.entry(r).or_default() += 1;
+    }
+    let large = |r: &usize| count[r] as f64 >= fraction * of.len() as f64;
+    if !count.keys().any(large) {
+        return (of.to_vec(), 0);
+    }
+    let dropped = count.keys().filter(|r| !large(r)).count();
+    let kept = of
+        .iter()
+        .zip(&root)
+        .filter(|(_, r)| large(r))
+        .map(|(&v, _)| v)
+        .collect();
+    (kept, dropped)
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}
+
+/// Of a point cloud's points `of`, those that pass the local-density test: a point's spacing
+/// at most [`OUTLIER_SPACING_FACTOR`] times the median spacing of its
+/// [`OUTLIER_NEIGHBOUR`] nearest neighbours (a local outlier factor, so that the density may
+/// vary across the cloud).
+pub fn dense_points(points: &[[f64; 3]], of: &[u32]) -> Vec<u32> {
+    if of.len() <= LINK_NEIGHBOURS {
+        return of.to_vec();
+    }
+    let hood = CloudNeighbourhoods::new(points, of);
+    of.iter()
+        .enumerate()
+        .filter(|&(i, _)| {
+            let around = median(
+                hood.near[i][..OUTLIER_NEIGHBOUR]
+                    .iter()
+                    .map(|&(j, _)| hood.spacing[j])
+                    .collect(),
+            );
+            hood.spacing[i] <= OUTLIER_SPACING_FACTOR * around
+        })
+        .map(|(_, &v)| v)
+        .collect()
+}
