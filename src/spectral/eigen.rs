@@ -94,7 +94,8 @@ impl Eigenbasis {
         check(progress, Stage::Laplacian, 0.0)?;
         let laplacian = Laplacian::new(shape)?;
         check(progress, Stage::Laplacian, 1.0)?;
-        let (values, compact) = eigenpairs(&laplacian, params, progress)?;
+        let (values, compact) =
+            eigenpairs(&laplacian, params, progress).map_err(|e| with_shape_hint(e, shape))?;
         let k = values.len();
         let active = shape.active_vertices();
         let mut row_of = vec![usize::MAX; shape.n_vertices()];
@@ -367,6 +368,37 @@ fn block_lanczos(
             "block Lanczos did not converge to {k} eigenpairs within {max_dim} vectors"
         ),
     })
+}
+
+/// An eigensolver failure with what about the shape likely caused it and how to fix it.
+fn with_shape_hint(error: Error, shape: &Shape) -> Error {
+    let Error::Numerical { stage, reason } = error else {
+        return error;
+    };
+    let pieces = shape.n_pieces();
+    let hint = if pieces > 1 {
+        format!(
+            "the shape has {pieces} disconnected pieces, each adding a zero eigenvalue: weld \
+             its seams and leave out loose pieces (the default repairs do both unless they \
+             were switched off), or match the pieces separately"
+        )
+    } else if shape
+        .warnings()
+        .iter()
+        .any(|w| matches!(w, crate::Warning::NeedleOrZeroAreaFaces { .. }))
+    {
+        "the shape has (near) zero-area faces: remesh it or clean it up (e.g. merge close \
+         vertices) and try again"
+            .to_string()
+    } else {
+        "the shape may have a degenerate or nearly detached region: check it with \
+         `shapecorr info`, or ask for fewer eigenpairs"
+            .to_string()
+    };
+    Error::Numerical {
+        stage,
+        reason: format!("{reason}; {hint}"),
+    }
 }
 
 /// The outcome of a convergence check.
