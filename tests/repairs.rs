@@ -89,7 +89,7 @@ fn clean(mesh: &FigureMesh) -> Corrupted {
 
 /// The vertices of the faces on the +x side that touch a face on the -x side are split:
 /// those faces get copies appended at the end (a UV seam as exporters write it).
-fn seam_split(mesh: &FigureMesh) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<Option<u32>>) {
+fn seam_split(mesh: &FigureMesh) -> (FigureMesh, Vec<Option<u32>>) {
     let n = mesh.vertices.len();
     let right = |t: &[u32; 3]| t.iter().map(|&v| mesh.vertices[v as usize][0]).sum::<f64>() > 0.0;
     let mut on_left = vec![false; n];
@@ -121,7 +121,13 @@ fn seam_split(mesh: &FigureMesh) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<Option<u3
             })
         })
         .collect();
-    (vertices, triangles, original)
+    (
+        FigureMesh {
+            vertices,
+            triangles,
+        },
+        original,
+    )
 }
 
 fn repaired(
@@ -157,7 +163,13 @@ fn seams_soups_debris_and_far_vertices_are_repaired() {
     println!("clean: accuracy {:.3}, error {:.4}", baseline.0, baseline.1);
     assert!(baseline.0 > 0.9 && baseline.1 < 0.03, "{baseline:?}");
 
-    let (vertices, triangles, original) = seam_split(&mesh_a);
+    let (
+        FigureMesh {
+            vertices,
+            triangles,
+        },
+        original,
+    ) = seam_split(&mesh_a);
     assert!(vertices.len() > mesh_a.vertices.len() + 20);
     let unrepaired = Shape::mesh_with(
         vertices.clone(),

@@ -296,7 +296,11 @@ impl Shape {
             });
         }
         let mut warnings = Vec::new();
-        let (triangles, active, welded_to) = match kind {
+        let Repaired {
+            triangles,
+            active,
+            welded_to,
+        } = match kind {
             ShapeKind::Mesh => Shape::repaired_mesh(&vertices, polygons, repairs, &mut warnings)?,
             ShapeKind::PointCloud => Shape::repaired_cloud(&vertices, repairs, &mut warnings),
         };
@@ -369,7 +373,7 @@ impl Shape {
         polygons: &[&[u32]],
         repairs: &Repairs,
         warnings: &mut Vec<Warning>,
-    ) -> Result<(Vec<[u32; 3]>, Vec<u32>, Vec<u32>)> {
+    ) -> Result<Repaired> {
         let n = vertices.len();
         // Indices are checked before anything looks at them.
         let mut triangles = clean_faces(vertices, polygons, warnings)?;
@@ -458,7 +462,11 @@ impl Shape {
                 count: unreferenced,
             });
         }
-        Ok((triangles, active, welded_to))
+        Ok(Repaired {
+            triangles,
+            active,
+            welded_to,
+        })
     }
 
     /// A point cloud's active points and every point's weld target, after the [`Repairs`]:
@@ -468,7 +476,7 @@ impl Shape {
         vertices: &[[f64; 3]],
         repairs: &Repairs,
         warnings: &mut Vec<Warning>,
-    ) -> (Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
+    ) -> Repaired {
         let all: Vec<u32> = (0..vertices.len() as u32).collect();
         let mut active = all.clone();
         if repairs.outliers {
@@ -512,7 +520,11 @@ impl Shape {
                 active = kept;
             }
         }
-        (Vec::new(), active, welded_to)
+        Repaired {
+            triangles: Vec::new(),
+            active,
+            welded_to,
+        }
     }
 
     /// Vertex positions in the caller's order and units.
@@ -758,6 +770,16 @@ impl Shape {
         roots.dedup();
         roots.len()
     }
+}
+
+/// What the repairs leave of a shape's input.
+struct Repaired {
+    /// The kept, cleaned triangles (none for a point cloud).
+    triangles: Vec<[u32; 3]>,
+    /// The kept vertices, ascending.
+    active: Vec<u32>,
+    /// For every vertex, the vertex it was welded to (itself when none).
+    welded_to: Vec<u32>,
 }
 
 /// A face whose area is below this fraction of the mean face area counts as a needle.

@@ -158,13 +158,19 @@ fn one_pair(
         shapecorr::spectral::descriptors::hks(basis_a, &hks_p)?,
         shapecorr::spectral::descriptors::hks(basis_b, &hks_p)?,
     );
-    let extra: Vec<(f64, f64, Option<f64>)> = maps
+    let extra: Vec<(f64, f64, Option<f64>, f64)> = maps
         .iter()
         .map(|(_, p2p, _)| {
+            let mut hit = vec![false; a.n_vertices()];
+            for &x in p2p {
+                hit[x as usize] = true;
+            }
+            let covered = hit.iter().filter(|&&h| h).count() as f64 / a.n_vertices() as f64;
             (
                 misfit(&wa, &wb, p2p),
                 misfit(&ha, &hb, p2p),
                 shapecorr::maps::hypotheses::orientation_score(a, b, p2p),
+                covered,
             )
         })
         .collect();
@@ -175,7 +181,7 @@ fn one_pair(
     for (i, (h, s)) in verdict.scores.iter().zip(&scores).enumerate() {
         let e = &h.energy;
         println!(
-            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"wks_misfit\":{:.5},\"hks_misfit\":{:.5},\"orient_full\":{:.4},\"seconds\":{seconds:.3}}}",
+            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"wks_misfit\":{:.5},\"hks_misfit\":{:.5},\"orient_full\":{:.4},\"cover_full\":{:.4},\"seconds\":{seconds:.3}}}",
             pair.source,
             pair.target,
             h.kind.name(),
@@ -192,6 +198,7 @@ fn one_pair(
             extra[i].0,
             extra[i].1,
             extra[i].2.unwrap_or(f64::NAN),
+            extra[i].3,
         );
         summary.push_str(&format!(
             " {}{}={:.3}/{:.4}",
