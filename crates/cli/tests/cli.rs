@@ -473,8 +473,14 @@ fn help_lists_one_flag_per_option_of_the_table() {
         .map(|o| flag(o.name))
         .collect();
     for (command, own) in [
-        (&["match", "--help"][..], &["--out", "--points"][..]),
-        (&["symmetry", "--help"], &["--out", "--points"]),
+        (
+            &["match", "--help"][..],
+            &["--out", "--points", "--no-repair"][..],
+        ),
+        (
+            &["symmetry", "--help"],
+            &["--out", "--points", "--no-repair"],
+        ),
         (
             &["bench", "regions", "--help"],
             &["--data", "--pairs", "--limit", "--basis-cache"],
@@ -695,4 +701,50 @@ fn bad_options_exit_non_zero_naming_the_option() {
         stderr.contains("k_min") || stderr.contains("k_max"),
         "{stderr}"
     );
+}
+
+/// A figure written as a triangle soup (every face with its own corners): `match` welds it
+/// and says so on stderr, naming the input; `--no-repair` matches it as given, without the
+/// line.
+#[test]
+fn repairs_are_printed_and_can_be_switched_off() {
+    let dir = scratch("repairs");
+    let (a, b, soup) = (dir.join("a.ply"), dir.join("b.ply"), dir.join("soup.ply"));
+    synth_figure("humanoid", "0", "1200", &a);
+    synth_figure("humanoid", "3", "1200", &b);
+    let shape = shapecorr::Shape::read(&a, shapecorr::ReadAs::Auto).unwrap();
+    let corners: Vec<[f64; 3]> = shape
+        .triangles()
+        .iter()
+        .flat_map(|t| t.map(|v| shape.vertices()[v as usize]))
+        .collect();
+    let faces: Vec<[u32; 3]> = (0..shape.triangles().len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    shapecorr::shape::io::write_ply(&soup, &corners, &faces, None).unwrap();
+    let out_dir = dir.join("out");
+    let args = [
+        "match",
+        soup.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ];
+    let out = shapecorr(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let expected = format!("shapecorr: repaired A ({}): ", soup.display());
+    let repaired: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("shapecorr: repaired"))
+        .collect();
+    assert_eq!(repaired.len(), 1, "{stderr}");
+    assert!(
+        repaired[0].starts_with(&expected) && repaired[0].contains("welded"),
+        "{stderr}"
+    );
+    let out = shapecorr(&[&args[..], &["--no-repair"]].concat());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("repaired"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
 }
