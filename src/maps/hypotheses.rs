@@ -460,6 +460,83 @@ fn residual(s: &SampledZoomOut, basis_a: &Eigenbasis, basis_b: &Eigenbasis) -> f
     misfit / norm.max(1e-300)
 }
 
+/// A competitor (a hypothesis giving a different map, [`DIFFERENT_MAP`]) whose cost is within
+/// this ratio of the chosen one's makes a close call, decided at full resolution
+/// ([`full_consistency`]). The sample energies cannot tell a body's map from the one turned
+/// front to back with left and right swapped (both keep the orientation, the limbs are near
+/// cylinders); at full resolution the turned map folds the feet and face and reaches fewer
+/// vertices. Measured on 123 development pairs (issue 18, docs/decisions.md "Close calls"):
+/// FAUST_r failures 6 -> 2 of 29, camel gallop, TOSCA_r and FAUST unchanged, at every
+/// ratio from 1.2 to 3.
+pub const CLOSE_CALL: f64 = 1.5;
+
+/// The relative full-resolution consistency margin at which the margin factor of a close
+/// call's confidence is 1 - 1/e (the margins measured were 1% to 8%).
+pub const FULL_MARGIN_SCALE: f64 = 0.05;
+
+/// Consistency of a full-resolution map from B to A: the fraction of A's active vertices it
+/// reaches times the fraction of B's oriented faces whose image keeps its orientation.
+pub fn full_consistency(a: &Shape, (faces_a, faces_b): &OrientedFaces, p2p_ba: &[u32]) -> f64 {
+    let normals_a = vertex_normals(a.vertices(), faces_a);
+    let (mut kept, mut total) = (0usize, 0usize);
+    for t in faces_b {
+        let turn = signed_turn(a.vertices(), t.map(|v| p2p_ba[v as usize] as usize), &normals_a);
+        if turn != 0.0 {
+            total += 1;
+            kept += usize::from(turn > 0.0);
+        }
+    }
+    let reached = covered_vertices(p2p_ba, a.n_vertices()) as f64;
+    reached / a.active_vertices().len().max(1) as f64 * kept as f64 / total.max(1) as f64
+}
+
+impl Verdict {
+    /// The competitor of a close call ([`CLOSE_CALL`]), if there is one.
+    pub fn close_call(&self) -> Option<usize> {
+        let best = self.chosen().energy.cost();
+        self.scores
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.distance_to_chosen > DIFFERENT_MAP)
+            .min_by(|x, y| x.1.energy.cost().total_cmp(&y.1.energy.cost()))
+            .filter(|(_, s)| s.energy.cost() < CLOSE_CALL * best)
+            .map(|(h, _)| h)
+    }
+
+    /// Settles a close call with the full-resolution consistencies of the chosen hypothesis
+    /// and its competitor `rival`: the more consistent is chosen (the chosen one keeps ties),
+    /// `distance_to_chosen` follows it (`sample_maps`, on A's vertices `va` of area `area_a`),
+    /// and the confidence's margin factor becomes the relative consistency margin against
+    /// [`FULL_MARGIN_SCALE`]. Returns whether the choice changed.
+    pub fn settle(
+        &mut self,
+        rival: usize,
+        (chosen_full, rival_full): (f64, f64),
+        sample_maps: &[&[u32]],
+        (va, area_a): (&[[f64; 3]], f64),
+    ) -> bool {
+        let changed = rival_full > chosen_full;
+        if changed {
+            self.chosen = rival;
+            let scale = 1.0 / area_a.sqrt();
+            for (h, score) in self.scores.iter_mut().enumerate() {
+                score.distance_to_chosen =
+                    mean_image_distance(sample_maps[h], sample_maps[rival], va) * scale;
+            }
+        }
+        let (winner, loser) = if changed {
+            (rival_full, chosen_full)
+        } else {
+            (chosen_full, rival_full)
+        };
+        let relative = (winner - loser) / winner.max(1e-12);
+        let consistency = (-self.chosen().energy.cost() / COST_SCALE).exp();
+        let margin = 1.0 - (-relative.max(0.0) / FULL_MARGIN_SCALE).exp();
+        self.confidence = (consistency * margin).clamp(0.0, 1.0);
+        changed
+    }
+}
+
 /// The hypothesis of lowest [`MapEnergy::cost`] (the first among equals) and the verdict.
 /// `sample_maps`: each hypothesis's map from B's samples to vertices of A (`va`, whose
 /// area is `area_a`), to tell which hypotheses give a different map.

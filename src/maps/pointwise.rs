@@ -273,7 +273,7 @@ impl PointwiseMap {
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
         let (fmap_ab, p2p_ba, verdict) = if fmaps.len() > 1 {
-            let verdict = verified(
+            let (verdict, chosen_map) = verified(
                 (a, basis_a),
                 (b, basis_b),
                 faces.as_ref(),
@@ -286,11 +286,13 @@ impl PointwiseMap {
                 // The chosen map is already refined on the samples.
                 Refinement::ZoomOut(_) => {
                     let fmap = verdict.scores[verdict.chosen].fmap_ab.clone();
-                    let p2p = fmap_to_p2p(
-                        fmap.as_ref(),
-                        basis_a.vectors.as_ref(),
-                        basis_b.vectors.as_ref(),
-                    );
+                    let p2p = chosen_map.unwrap_or_else(|| {
+                        fmap_to_p2p(
+                            fmap.as_ref(),
+                            basis_a.vectors.as_ref(),
+                            basis_b.vectors.as_ref(),
+                        )
+                    });
                     (fmap, p2p)
                 }
                 _ => refine(&fmaps[verdict.chosen], (basis_a, basis_b), params, k)?,
@@ -387,7 +389,7 @@ fn verified(
     fmaps: &[Mat<f64>],
     params: &PointwiseParams,
     k: usize,
-) -> Result<Verdict> {
+) -> Result<(Verdict, Option<Vec<u32>>)> {
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
     let decision = match &params.refinement {
         Refinement::ZoomOut(z) => z.clone(),
@@ -410,13 +412,32 @@ fn verified(
     let energies = hypotheses::energies((a, basis_a), (b, basis_b), faces, &sampled);
     let sample_maps: Vec<&[u32]> = sampled.iter().map(|s| s.p2p_ba.as_slice()).collect();
     let sample_fmaps = sampled.iter().map(|s| s.fmap_ab.clone()).collect();
-    Ok(hypotheses::choose(
+    let mut verdict = hypotheses::choose(
         kinds,
         energies,
         sample_fmaps,
         &sample_maps,
         (a.vertices(), basis_a.input_area),
-    ))
+    );
+    // A close call is decided at full resolution, where the meshes' orientation is known.
+    let mut chosen_map = None;
+    if let (Some(rival), Some(faces)) = (verdict.close_call(), faces) {
+        let [chosen_p2p, rival_p2p] = [verdict.chosen, rival].map(|h| {
+            fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b)
+        });
+        let consistency = (
+            hypotheses::full_consistency(a, faces, &chosen_p2p),
+            hypotheses::full_consistency(a, faces, &rival_p2p),
+        );
+        let changed = verdict.settle(
+            rival,
+            consistency,
+            &sample_maps,
+            (a.vertices(), basis_a.input_area),
+        );
+        chosen_map = Some(if changed { rival_p2p } else { chosen_p2p });
+    }
+    Ok((verdict, chosen_map))
 }
 
 /// Descriptor columns of one shape, computed once for every region set any candidate uses.

@@ -12,9 +12,9 @@
 
 use std::path::PathBuf;
 
-use shapecorr::correspondence::{Correspondence, Params};
+use shapecorr::correspondence::Params;
 use shapecorr::maps::fmap::fmap_to_p2p;
-use shapecorr::maps::pointwise::{truncated, PointwiseMap, PointwiseParams};
+use shapecorr::maps::pointwise::{truncated, PointwiseParams};
 use shapecorr::progress::NoProgress;
 use shapecorr::spectral::eigen::EigenParams;
 use shapecorr_eval::bench_pointwise::score_maps;
@@ -97,22 +97,21 @@ fn one_pair(
         &store.basis(&pair.source).basis,
         &store.basis(&pair.target).basis,
     );
-    let regions = Correspondence::from_bases(
-        a,
-        &truncated(basis_a, params.eigen.n_eigenpairs),
-        b,
-        &truncated(basis_b, params.eigen.n_eigenpairs),
+    let t = std::time::Instant::now();
+    // The pipeline's path (`p2p`): unverified regions, hypotheses verified by the map.
+    let (_, map) = shapecorr::maps::pointwise::regions_and_map(
+        (a, basis_a),
+        (b, basis_b),
         params,
+        pointwise,
         &mut NoProgress,
     )?;
-    let t = std::time::Instant::now();
+    let seconds = t.elapsed().as_secs_f64();
     let (basis_a, basis_b) = (
         &truncated(basis_a, pointwise.n_eigenpairs),
         &truncated(basis_b, pointwise.n_eigenpairs),
     );
-    let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(&regions), pointwise)?;
-    let seconds = t.elapsed().as_secs_f64();
-    let Some(verdict) = map.verdict.as_ref().or(regions.verdict.as_ref()) else {
+    let Some(verdict) = map.verdict.as_ref() else {
         eprintln!("{name} {} -> {}: one hypothesis", pair.source, pair.target);
         return Ok(());
     };
