@@ -86,6 +86,7 @@ impl Params {
     /// Checks every parameter's range before any work starts, so a bad value fails at once
     /// with [`crate::Error::InvalidParameter`] instead of after the eigensolver.
     pub fn validate(&self) -> Result<()> {
+        self.check_option_ranges()?;
         self.eigen.validate()?;
         self.hks.validate()?;
         self.segmentation.validate()?;

@@ -43,6 +43,9 @@ pub struct EigenParams {
     /// Threads for the dense matrix products (0 = all available). The result does not depend
     /// on it.
     pub threads: usize,
+    /// Largest shape accepted, in vertices ([`DEFAULT_MAX_VERTICES`]): a larger shape is
+    /// refused before the Laplacian is built.
+    pub max_vertices: usize,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -57,8 +60,25 @@ impl Default for EigenParams {
             block_size: 4,
             seed: 0x5eed,
             threads: 0,
+            max_vertices: DEFAULT_MAX_VERTICES,
             non_exhaustive: crate::NonExhaustive(()),
         }
+    }
+}
+
+/// Default [`EigenParams::max_vertices`]: 2 million vertices. Measured (issue 19): a
+/// 300K-vertex pair took 289 s and 1.47 GB on a 2-core machine, so 2M is about 10 GB and
+/// half an hour, the most a desktop can do; larger shapes should be simplified first.
+pub const DEFAULT_MAX_VERTICES: usize = 2_000_000;
+
+/// The threads the dense products use: `threads` (0: all) clamped to the machine's cores,
+/// so that a huge value neither spins nor oversubscribes.
+pub fn effective_threads(threads: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if threads == 0 {
+        cores
+    } else {
+        threads.min(cores)
     }
 }
 
@@ -92,6 +112,7 @@ impl Eigenbasis {
         progress: &mut dyn Progress,
     ) -> Result<Eigenbasis> {
         check(progress, Stage::Laplacian, 0.0)?;
+        check_size(shape, params)?;
         let laplacian = Laplacian::new(shape)?;
         check(progress, Stage::Laplacian, 1.0)?;
         let (values, compact) = eigenpairs(&laplacian, params, progress)?;
@@ -135,6 +156,22 @@ impl EigenParams {
     }
 }
 
+/// Refuses a shape above [`EigenParams::max_vertices`] before anything is allocated.
+fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
+    let n = shape.active_vertices().len();
+    if n > params.max_vertices {
+        return Err(Error::InvalidParameter {
+            name: "max_vertices",
+            reason: format!(
+                "the shape has {n} vertices, more than max_vertices = {}; simplify it or \
+                 raise max_vertices",
+                params.max_vertices
+            ),
+        });
+    }
+    Ok(())
+}
+
 fn validate(params: &EigenParams) -> Result<()> {
     let bad = |name, reason: &str| {
         Err(Error::InvalidParameter {
@@ -167,10 +204,9 @@ pub fn eigenpairs(
     validate(params)?;
     let n = laplacian.len();
     let k = params.n_eigenpairs.min(n);
-    let par = if params.threads == 1 {
-        Par::Seq
-    } else {
-        Par::rayon(params.threads)
+    let par = match effective_threads(params.threads) {
+        1 => Par::Seq,
+        threads => Par::rayon(threads),
     };
     let (mut values, mut vectors) = if n <= DENSE_LIMIT || 3 * k + 4 * params.block_size >= n {
         dense_eigenpairs(laplacian, k)?

@@ -119,7 +119,15 @@ fn help(info: &OptionInfo) -> String {
         .option(info.name)
         .map(|v| value_text(info.name, v))
         .unwrap_or_default();
-    format!("{} [default: {default}]", info.doc)
+    match info.option_type {
+        OptionType::Bool => format!("{} [default: {default}]", info.doc),
+        _ if info.name == "seed" => format!("{} [default: {default}]", info.doc),
+        _ => format!(
+            "{} [default: {default}] [range: {}]",
+            info.doc,
+            info.range_text()
+        ),
+    }
 }
 
 fn invalid(cmd: &Command, message: String) -> clap::Error {
