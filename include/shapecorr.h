@@ -427,6 +427,13 @@ const char *sc_option_doc(size_t index);
 // `UINT32_MAX` past the end.
 uint32_t sc_option_type(size_t index);
 
+// Smallest accepted value of option `index` (0 for a bool); NaN past the end. A value
+// outside `[sc_option_min, sc_option_max]` is refused with `SC_STATUS_INVALID_PARAMETER`.
+double sc_option_min(size_t index);
+
+// Largest accepted value of option `index` (1 for a bool); NaN past the end.
+double sc_option_max(size_t index);
+
 // Point-to-point map from shape `b` to shape `a` (meshes, point clouds or one of each):
 // the region correspondence of `sc_match`, then a functional map constrained by the matched
 // regions (options `p2p_*`), converted to a vertex map and refined. Each shape's eigenbasis

@@ -88,7 +88,16 @@ impl OptionInfo {
 
     /// The accepted range as text, e.g. `[1, 100]`.
     pub fn range_text(&self) -> String {
-        format!("[{}, {}]", self.min, self.max)
+        format!("[{}, {}]", number_text(self.min), number_text(self.max))
+    }
+}
+
+/// A number as people read it: `100`, `0.5`, `1e-6`, `1e12`.
+fn number_text(v: f64) -> String {
+    if v != 0.0 && !(1e-3..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 
@@ -457,7 +466,7 @@ fn to_finite(info: &OptionInfo, value: f64) -> Result<f64> {
         });
     }
     if !(info.min..=info.max).contains(&value) {
-        return Err(out_of_range(info, value));
+        return Err(out_of_range(info, number_text(value)));
     }
     Ok(value)
 }
