@@ -186,3 +186,26 @@ fn threads_above_the_cores_are_clamped() {
     assert_eq!(effective_threads(1), 1);
     assert_eq!(effective_threads(1_000_000_000_000), cores);
 }
+
+/// Issue 19, item 17: an error about one shape of a pair says which.
+#[test]
+fn an_error_about_one_shape_of_a_pair_names_it() {
+    let a = humanoid(0, 700);
+    let b = humanoid(3, 1400);
+    let mut options = Options::default();
+    options
+        .set_option("max_vertices", OptionValue::Int(1000))
+        .unwrap();
+    let err =
+        shapecorr::Correspondence::compute(&a, &b, &options.params, &mut shapecorr::NoProgress)
+            .unwrap_err();
+    assert!(matches!(err, Error::InShape { side: 'B', .. }), "{err}");
+    assert!(matches!(
+        err.innermost(),
+        Error::InvalidParameter {
+            name: "max_vertices",
+            ..
+        }
+    ));
+    assert!(err.to_string().starts_with("shape B: "), "{err}");
+}

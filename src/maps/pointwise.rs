@@ -682,10 +682,12 @@ impl PointwiseCorrespondence {
             n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
             ..params.eigen.clone()
         };
-        let basis_a = Eigenbasis::compute_with_progress(a, &eigen, progress)?;
+        let basis_a =
+            Eigenbasis::compute_with_progress(a, &eigen, progress).map_err(|e| e.in_shape('A'))?;
         let eigenbasis_a = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let basis_b = Eigenbasis::compute_with_progress(b, &eigen, progress)?;
+        let basis_b =
+            Eigenbasis::compute_with_progress(b, &eigen, progress).map_err(|e| e.in_shape('B'))?;
         let eigenbasis_b = t.elapsed().as_secs_f64();
         let (regions, map) =
             regions_and_map((a, &basis_a), (b, &basis_b), params, pointwise, progress)?;

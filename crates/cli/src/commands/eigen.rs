@@ -55,7 +55,7 @@ impl EigenArgs {
         }
         if self.json {
             let value = json!({
-                "file": file,
+                "file": file.to_string_lossy(),
                 "n_vertices": shape.n_vertices(),
                 "k": values.len(),
                 "eigenvalues": values,

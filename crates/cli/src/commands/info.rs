@@ -30,7 +30,7 @@ impl InfoArgs {
         };
         if self.json {
             let value = json!({
-                "file": file,
+                "file": file.to_string_lossy(),
                 "kind": shape.kind(),
                 "n_vertices": shape.n_vertices(),
                 "n_faces": shape.triangles().len(),

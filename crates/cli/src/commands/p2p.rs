@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use shapecorr::maps::pointwise::PointwiseCorrespondence;
-use shapecorr::ReadAs;
-use shapecorr::{Error, Shape};
+use shapecorr::Error;
 
+use crate::commands::{naming_files, read_input};
 use crate::options::PointwiseOptions;
 use crate::output::{
     confidence_summary, correspondence_json, create_dir, end_progress_line, options_json,
@@ -30,8 +30,8 @@ pub struct P2pArgs {
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let shape_a = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
-        let shape_b = Shape::read(&self.b, ReadAs::point_cloud_when(self.points))?;
+        let shape_a = read_input('A', &self.a, self.points)?;
+        let shape_b = read_input('B', &self.b, self.points)?;
         let out = &self.out;
         create_dir(out)?;
         let result = PointwiseCorrespondence::compute(
@@ -42,7 +42,7 @@ impl P2pArgs {
             &mut TerminalProgress,
         );
         end_progress_line();
-        let result = result?;
+        let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
         let map = &result.map.p2p_ba;
         write_map(&out.join("map_b_to_a.txt"), map)?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result.regions);

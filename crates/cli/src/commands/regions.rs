@@ -8,6 +8,7 @@ use shapecorr::correspondence::{Correspondence, Symmetry};
 use shapecorr::ReadAs;
 use shapecorr::{Error, Shape};
 
+use crate::commands::{naming_files, read_input};
 use crate::options::RegionOptions;
 use crate::output::{
     confidence_summary, correspondence_json, create_dir, end_progress_line, graph_json,
@@ -31,14 +32,14 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape_a = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
-        let shape_b = Shape::read(&self.b, ReadAs::point_cloud_when(self.points))?;
+        let shape_a = read_input('A', &self.a, self.points)?;
+        let shape_b = read_input('B', &self.b, self.points)?;
         let out = &self.out;
         create_dir(out)?;
         let result =
             Correspondence::compute(&shape_a, &shape_b, &options.params, &mut TerminalProgress);
         end_progress_line();
-        let result = result?;
+        let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
         value["options"] = options_json(&options, false);
         write_json(&out.join("result.json"), &value)?;
