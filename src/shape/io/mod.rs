@@ -195,7 +195,11 @@ fn text_of(bytes: &[u8]) -> Cow<'_, str> {
 /// surrounding white space trimmed and empty lines skipped.
 fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
     text.split('\n').enumerate().filter_map(|(i, line)| {
-        let line = line.split('#').next().unwrap_or_default().trim();
+        let line = line
+            .split('#')
+            .next()
+            .unwrap_or_default()
+            .trim_matches(|c: char| c.is_ascii_whitespace());
         (!line.is_empty()).then_some((i + 1, line))
     })
 }
