@@ -205,12 +205,22 @@ fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
 }
 
 /// A token for an error message, cut to a readable length.
+/// Characters other than printable ASCII are written as `\u{85}`, so an invisible one
+/// (a Unicode space inside a number) shows.
 fn shown(token: &str) -> String {
     const MAX: usize = 40;
+    let visible = |c: char| {
+        if c.is_ascii_graphic() || c == ' ' {
+            c.to_string()
+        } else {
+            c.escape_unicode().to_string()
+        }
+    };
+    let cut: String = token.chars().take(MAX).map(visible).collect();
     if token.chars().count() <= MAX {
-        token.to_string()
+        cut
     } else {
-        format!("{}...", token.chars().take(MAX).collect::<String>())
+        format!("{cut}...")
     }
 }
 

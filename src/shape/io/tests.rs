@@ -284,6 +284,8 @@ fn unicode_white_space_is_not_a_separator() {
             };
             assert!(message.contains(file), "{message}");
             assert!(message.contains("line"), "{file}: {message}");
+            let escaped = odd.escape_unicode().to_string();
+            assert!(message.contains(&escaped), "{file}: {message}");
         }
     }
 }
