@@ -82,6 +82,16 @@ pub fn effective_threads(threads: usize) -> usize {
     }
 }
 
+/// Fixes faer's global parallelism (its matrix products and dense decompositions) to the
+/// machine's cores, once per process. faer splits work by its `Par`'s thread count and the
+/// split changes the rounding; its default, `Par::rayon(0)`, takes the size of the current
+/// rayon pool, so results differed in the last digits between RAYON_NUM_THREADS=1 and 2
+/// (issue 19). Fixed, they are bit-identical for any pool size on one machine.
+pub fn fix_faer_parallelism() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| faer::set_global_parallelism(Par::rayon(effective_threads(0))));
+}
+
 /// Below this many active vertices the dense eigensolver is used.
 const DENSE_LIMIT: usize = 600;
 
@@ -202,6 +212,7 @@ pub fn eigenpairs(
     progress: &mut dyn Progress,
 ) -> Result<(Vec<f64>, Mat<f64>)> {
     validate(params)?;
+    fix_faer_parallelism();
     let n = laplacian.len();
     let k = params.n_eigenpairs.min(n);
     let par = match effective_threads(params.threads) {
