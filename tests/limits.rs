@@ -209,3 +209,49 @@ fn an_error_about_one_shape_of_a_pair_names_it() {
     ));
     assert!(err.to_string().starts_with("shape B: "), "{err}");
 }
+
+/// Issue 19, item 18: a valid shape scaled by 1e-100 (its area, 1e-200, is representable
+/// but its squared lengths are not) gives the same Laplacian and the same regions.
+#[test]
+fn a_shape_scaled_by_1e_minus_100_gives_the_same_answer() {
+    let mesh = synth::figure(&FigureSpec {
+        kind: FigureKind::Humanoid,
+        target_vertices: 700,
+        ..Default::default()
+    })
+    .unwrap();
+    let tiny: Vec<[f64; 3]> = mesh
+        .vertices
+        .iter()
+        .map(|v| v.map(|x| x * 1e-100))
+        .collect();
+    let plain = Shape::mesh(mesh.vertices.clone(), &mesh.triangles).unwrap();
+    let small = Shape::mesh(tiny, &mesh.triangles).unwrap();
+    let (lp, ls) = (
+        shapecorr::spectral::laplacian::Laplacian::new(&plain).unwrap(),
+        shapecorr::spectral::laplacian::Laplacian::new(&small).unwrap(),
+    );
+    let relative = (ls.input_area / (lp.input_area * 1e-200) - 1.0).abs();
+    assert!(
+        relative < 1e-9,
+        "area {} vs {}",
+        ls.input_area,
+        lp.input_area
+    );
+    let close = lp
+        .mass
+        .iter()
+        .zip(&ls.mass)
+        .all(|(a, b)| (a - b).abs() <= 1e-9 * a);
+    assert!(close, "masses differ");
+    let b = humanoid(3, 700);
+    let params = Options::default().params;
+    let with_plain =
+        shapecorr::Correspondence::compute(&plain, &b, &params, &mut shapecorr::NoProgress)
+            .unwrap();
+    let with_small =
+        shapecorr::Correspondence::compute(&small, &b, &params, &mut shapecorr::NoProgress)
+            .unwrap();
+    assert_eq!(with_plain.graph_a.labels, with_small.graph_a.labels);
+    assert_eq!(with_plain.matches, with_small.matches);
+}

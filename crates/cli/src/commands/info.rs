@@ -49,8 +49,8 @@ impl InfoArgs {
             println!("kind:        {kind}");
             println!("vertices:    {}", shape.n_vertices());
             println!("faces:       {}", shape.triangles().len());
-            println!("area:        {:.6}", laplacian.input_area);
-            println!("width:       {:.6}", shape.width());
+            println!("area:        {:.6e}", laplacian.input_area);
+            println!("width:       {:.6e}", shape.width());
             println!("pieces:      {}", shape.n_pieces());
             for w in warnings {
                 println!("warning:     {w}");
