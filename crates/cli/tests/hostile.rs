@@ -203,3 +203,40 @@ fn a_bad_shape_in_a_pair_names_its_side_and_file() {
         assert_clean_failure(&out, &["shape A", bad.to_str().unwrap()]);
     }
 }
+
+/// Issue 19, item 9: stderr that is not a terminal gets progress lines (at most one a
+/// second), `--quiet` none.
+#[test]
+fn progress_is_written_as_lines_when_stderr_is_not_a_terminal() {
+    let dir = scratch("progress");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth(&a, "0");
+    synth(&b, "3");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let out_dir = dir.join("out");
+    // 400 k-means restarts: several seconds of segmentation.
+    let args = [
+        "match",
+        a,
+        b,
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--kmeans-restarts",
+        "400",
+    ];
+    let out = shapecorr(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let lines: Vec<String> = stderr(&out)
+        .lines()
+        .filter(|l| l.starts_with("shapecorr: progress: "))
+        .map(str::to_string)
+        .collect();
+    assert!(!lines.is_empty(), "no progress lines: {}", stderr(&out));
+    assert!(
+        lines.iter().any(|l| l.contains("Segmentation")),
+        "{lines:?}"
+    );
+    let quiet = shapecorr(&[&args[..], &["--quiet"]].concat());
+    assert!(quiet.status.success());
+    assert!(!stderr(&quiet).contains("progress"), "{}", stderr(&quiet));
+}

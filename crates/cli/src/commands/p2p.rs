@@ -39,7 +39,7 @@ impl P2pArgs {
             &shape_b,
             &options.params,
             &pointwise,
-            &mut TerminalProgress,
+            &mut TerminalProgress::new(),
         );
         end_progress_line();
         let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;

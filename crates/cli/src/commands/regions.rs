@@ -36,8 +36,12 @@ impl MatchArgs {
         let shape_b = read_input('B', &self.b, self.points)?;
         let out = &self.out;
         create_dir(out)?;
-        let result =
-            Correspondence::compute(&shape_a, &shape_b, &options.params, &mut TerminalProgress);
+        let result = Correspondence::compute(
+            &shape_a,
+            &shape_b,
+            &options.params,
+            &mut TerminalProgress::new(),
+        );
         end_progress_line();
         let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
@@ -78,7 +82,7 @@ impl SymmetryArgs {
         let shape = Shape::read(&self.a, ReadAs::point_cloud_when(self.points))?;
         let out = &self.out;
         create_dir(out)?;
-        let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress);
+        let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress::new());
         end_progress_line();
         let symmetry = symmetry?;
         let colors = symmetry.vertex_colors();
