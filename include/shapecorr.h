@@ -585,7 +585,8 @@ sc_status sc_shape_new_point_cloud_f32(const float *xyz, size_t n_points, sc_sha
 // `SC_STATUS_FILE_ERROR` names the file and the problem.
 //
 // # Safety
-// `path` must be a NUL-terminated UTF-8 string; `out_shape` must be writable.
+// `path` must be a NUL-terminated string (UTF-8; on Unix any bytes, as the file system
+// takes them); `out_shape` must be writable.
 sc_status sc_shape_read(const char *path, bool as_point_cloud, sc_shape **out_shape);
 
 // A generated figure (closed mesh, for tests and demos): `kind` is `"humanoid"`,

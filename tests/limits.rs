@@ -255,3 +255,17 @@ fn a_shape_scaled_by_1e_minus_100_gives_the_same_answer() {
     assert_eq!(with_plain.graph_a.labels, with_small.graph_a.labels);
     assert_eq!(with_plain.matches, with_small.matches);
 }
+
+/// The memory check before the eigensolve: 1000 eigenpairs of a 2M-vertex shape need
+/// over 100 GB (refused on a machine with less), the defaults on 3,000 vertices a few MB.
+#[test]
+fn the_eigensolver_memory_estimate_scales_with_size_and_eigenpairs() {
+    use shapecorr::spectral::eigen::eigensolver_bytes;
+    let big = shapecorr::EigenParams {
+        n_eigenpairs: 1000,
+        ..Default::default()
+    };
+    assert!(eigensolver_bytes(2_000_000, &big) > 100_000_000_000);
+    let small = Options::default().params.eigen;
+    assert!(eigensolver_bytes(3000, &small) < 20_000_000);
+}

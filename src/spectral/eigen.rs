@@ -92,6 +92,10 @@ pub fn fix_faer_parallelism() {
     ONCE.call_once(|| faer::set_global_parallelism(Par::rayon(effective_threads(0))));
 }
 
+/// Most eigenpairs computed (the range of the options `eigenpairs` and `p2p_eigenpairs`):
+/// an n x 1000 basis of a 2M-vertex shape is 16 GB.
+pub const MAX_EIGENPAIRS: usize = 1000;
+
 /// Below this many active vertices the dense eigensolver is used.
 const DENSE_LIMIT: usize = 600;
 
@@ -166,9 +170,40 @@ impl EigenParams {
     }
 }
 
-/// Refuses a shape above [`EigenParams::max_vertices`] before anything is allocated.
+/// Bytes the eigensolver needs at most for `n` vertices: the Lanczos basis (up to
+/// `6k + 20b` vectors) and the eigenvectors, 8 bytes a value.
+pub fn eigensolver_bytes(n: usize, params: &EigenParams) -> u64 {
+    let k = params.n_eigenpairs.min(n) as u64;
+    let vectors = (6 * k + 20 * params.block_size as u64).min(n as u64) + 2 * k;
+    n as u64 * vectors * 8
+}
+
+/// The memory the system can give now (`MemAvailable`), where it says (Linux).
+fn available_bytes() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_ascii_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses a shape above [`EigenParams::max_vertices`], or one whose eigenbasis needs more
+/// memory than the system has, before anything is allocated.
 fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
     let n = shape.active_vertices().len();
+    let needed = eigensolver_bytes(n, params);
+    if let Some(available) = available_bytes().filter(|&a| needed > a) {
+        let gb = |b: u64| b as f64 / 1e9;
+        return Err(Error::InvalidParameter {
+            name: "eigenpairs",
+            reason: format!(
+                "{} eigenpairs of a {n}-vertex shape need about {:.1} GB, more than the \
+                 {:.1} GB available; ask for fewer eigenpairs or simplify the shape",
+                params.n_eigenpairs,
+                gb(needed),
+                gb(available)
+            ),
+        });
+    }
     if n > params.max_vertices {
         return Err(Error::InvalidParameter {
             name: "max_vertices",
@@ -189,8 +224,11 @@ fn validate(params: &EigenParams) -> Result<()> {
             reason: reason.to_string(),
         })
     };
-    if params.n_eigenpairs == 0 {
-        return bad("n_eigenpairs", "must be at least 1");
+    if params.n_eigenpairs == 0 || params.n_eigenpairs > MAX_EIGENPAIRS {
+        return bad(
+            "n_eigenpairs",
+            "must lie in [1, 1000] (the `eigenpairs` option's range)",
+        );
     }
     if !(params.shift > 0.0 && params.shift.is_finite()) {
         return bad("shift", "must be a positive finite number");
