@@ -399,7 +399,7 @@ mod tests {
     fn bad_values_name_the_flag_or_option() {
         for (args, expected) in [
             (&["--k-min", "five"][..], "--k-min"),
-            (&["--k-min", "-1"], "non-negative"),
+            (&["--k-min", "-1"], "must lie in [2, 100], got -1"),
             (&["--one-to-one", "maybe"], "true or false"),
             (&["--set", "nope=1"], "`nope`"),
             (&["--set", "k-max=3"], "did you mean `k_max`"),
