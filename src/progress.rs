@@ -95,11 +95,14 @@ pub(crate) fn polled<T: Send>(
     check(progress, stage, start)?;
     let cancel = Cancel::default();
     let threads = rayon::current_num_threads();
+    // A caller that is itself a worker of a pool only polls while it waits: the work gets a
+    // pool of its own, or a one-thread pool would never run it.
+    let caller_in_pool = rayon::current_thread_index().is_some();
     let outcome = std::thread::scope(|scope| {
         let cancel = &cancel;
         let caller = std::thread::current();
         let worker = scope.spawn(move || {
-            let result = in_pool_of(threads, || work(cancel));
+            let result = in_pool_of(threads, caller_in_pool, || work(cancel));
             caller.unpark();
             result
         });
@@ -124,10 +127,11 @@ pub(crate) fn polled<T: Send>(
     }
 }
 
-/// Runs `f` in a rayon pool of `threads` threads: the global pool when it has that size,
-/// else a pool made for the call (so that the caller's `ThreadPool::install` is kept).
-fn in_pool_of<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    if rayon::current_num_threads() == threads {
+/// Runs `f` in a rayon pool of `threads` threads: the global pool when it has that size and
+/// the caller is not a worker of a pool, else a pool made for the call (so the caller's
+/// `ThreadPool::install` size is kept and a waiting caller never blocks the work).
+fn in_pool_of<T: Send>(threads: usize, caller_in_pool: bool, f: impl FnOnce() -> T + Send) -> T {
+    if !caller_in_pool && rayon::current_num_threads() == threads {
         return f();
     }
     match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {

@@ -269,3 +269,41 @@ fn the_eigensolver_memory_estimate_scales_with_size_and_eigenpairs() {
     let small = Options::default().params.eigen;
     assert!(eigensolver_bytes(3000, &small) < 20_000_000);
 }
+
+/// A caller that is the only worker of the global pool (RAYON_NUM_THREADS=1, inside a
+/// parallel loop) must not deadlock while it polls for progress. Runs itself again as a
+/// child process with one global thread.
+#[test]
+fn a_job_started_from_the_only_global_pool_worker_finishes() {
+    const CHILD: &str = "SHAPECORR_TEST_ONE_THREAD_CHILD";
+    if std::env::var_os(CHILD).is_some() {
+        assert_eq!(rayon::current_num_threads(), 1);
+        let (a, b) = (humanoid(0, 700), humanoid(3, 700));
+        let params = Options::default().params;
+        let result = rayon::scope(|_| {
+            shapecorr::Correspondence::compute(&a, &b, &params, &mut shapecorr::NoProgress)
+        });
+        assert!(result.is_ok(), "{result:?}");
+        return;
+    }
+    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "a_job_started_from_the_only_global_pool_worker_finishes",
+        ])
+        .env(CHILD, "1")
+        .env("RAYON_NUM_THREADS", "1")
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_secs(60) {
+        if let Some(status) = child.try_wait().unwrap() {
+            assert!(status.success(), "the child failed: {status}");
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    panic!("the job deadlocked with one global thread");
+}
