@@ -305,5 +305,6 @@ fn a_job_started_from_the_only_global_pool_worker_finishes() {
         std::thread::sleep(Duration::from_millis(50));
     }
     child.kill().unwrap();
+    child.wait().unwrap();
     panic!("the job deadlocked with one global thread");
 }
