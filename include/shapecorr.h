@@ -444,6 +444,13 @@ const char *sc_option_doc(size_t index);
 // `UINT32_MAX` past the end.
 uint32_t sc_option_type(size_t index);
 
+// Smallest accepted value of option `index` (0 for a bool); NaN past the end. A value
+// outside `[sc_option_min, sc_option_max]` is refused with `SC_STATUS_INVALID_PARAMETER`.
+double sc_option_min(size_t index);
+
+// Largest accepted value of option `index` (1 for a bool); NaN past the end.
+double sc_option_max(size_t index);
+
 // Point-to-point map from shape `b` to shape `a` (meshes, point clouds or one of each):
 // the region correspondence of `sc_match`, then a functional map constrained by the matched
 // regions (options `p2p_*`), converted to a vertex map and refined. Each shape's eigenbasis
@@ -630,7 +637,8 @@ sc_status sc_shape_new_point_cloud_f32(const float *xyz, size_t n_points, sc_sha
 // `SC_STATUS_FILE_ERROR` names the file and the problem.
 //
 // # Safety
-// `path` must be a NUL-terminated UTF-8 string; `out_shape` must be writable.
+// `path` must be a NUL-terminated string (UTF-8; on Unix any bytes, as the file system
+// takes them); `out_shape` must be writable.
 sc_status sc_shape_read(const char *path, bool as_point_cloud, sc_shape **out_shape);
 
 // A generated figure (closed mesh, for tests and demos): `kind` is `"humanoid"`,

@@ -86,6 +86,7 @@ impl Params {
     /// Checks every parameter's range before any work starts, so a bad value fails at once
     /// with [`crate::Error::InvalidParameter`] instead of after the eigensolver.
     pub fn validate(&self) -> Result<()> {
+        self.check_option_ranges()?;
         self.eigen.validate()?;
         self.hks.validate()?;
         self.segmentation.validate()?;
@@ -163,10 +164,12 @@ impl Correspondence {
     ) -> Result<Correspondence> {
         params.validate()?;
         let started = Instant::now();
-        let basis_a = Eigenbasis::compute_with_progress(a, &params.eigen, progress)?;
+        let basis_a = Eigenbasis::compute_with_progress(a, &params.eigen, progress)
+            .map_err(|e| e.in_shape('A'))?;
         let t_a = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let basis_b = Eigenbasis::compute_with_progress(b, &params.eigen, progress)?;
+        let basis_b = Eigenbasis::compute_with_progress(b, &params.eigen, progress)
+            .map_err(|e| e.in_shape('B'))?;
         let t_b = t.elapsed().as_secs_f64();
         let mut result = Correspondence::from_bases(a, &basis_a, b, &basis_b, params, progress)?;
         result.timings.eigenbasis_a = t_a;

@@ -74,6 +74,15 @@ pub enum Error {
     /// The caller asked to stop through the progress callback.
     #[error("cancelled by the caller")]
     Cancelled,
+    /// An error about one shape of a pair: `side` says which (`'A'` or `'B'`). The C status
+    /// is the inner error's.
+    #[error("shape {side}: {source}")]
+    InShape {
+        /// `'A'` or `'B'`.
+        side: char,
+        /// What is wrong with that shape.
+        source: Box<Error>,
+    },
     /// An option name that does not exist (see [`crate::options::OPTIONS`]).
     #[error("unknown option `{name}`; the options are: {known}")]
     UnknownOption {
@@ -88,6 +97,28 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// This error as one about shape `side` (`'A'` or `'B'`) of a pair. A cancel, a file
+    /// error (it names the file) and a parameter error other than `max_vertices` are not
+    /// about a shape and stay as they are.
+    pub fn in_shape(self, side: char) -> Error {
+        match self {
+            Error::Cancelled | Error::File { .. } | Error::InShape { .. } => self,
+            Error::InvalidParameter { name, .. } if name != "max_vertices" => self,
+            _ => Error::InShape {
+                side,
+                source: Box::new(self),
+            },
+        }
+    }
+
+    /// The error itself, without the shape it is about ([`Error::InShape`]).
+    pub fn innermost(&self) -> &Error {
+        match self {
+            Error::InShape { source, .. } => source.innermost(),
+            _ => self,
+        }
+    }
+
     /// A file error naming the file and the problem.
     pub fn file(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
         Error::File {

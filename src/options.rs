@@ -73,6 +73,32 @@ pub struct OptionInfo {
     pub group: OptionGroup,
     /// One line: what it does.
     pub doc: &'static str,
+    /// Smallest accepted value (integers and floats; 0 for a bool).
+    pub min: f64,
+    /// Largest accepted value: what the pipeline can do in memory and time (see
+    /// docs/decisions.md, "Option ranges").
+    pub max: f64,
+}
+
+impl OptionInfo {
+    /// This option with the accepted range `[min, max]`.
+    const fn range(self, min: f64, max: f64) -> OptionInfo {
+        OptionInfo { min, max, ..self }
+    }
+
+    /// The accepted range as text, e.g. `[1, 100]`.
+    pub fn range_text(&self) -> String {
+        format!("[{}, {}]", number_text(self.min), number_text(self.max))
+    }
+}
+
+/// A number as people read it: `100`, `0.5`, `1e-6`, `1e12`.
+fn number_text(v: f64) -> String {
+    if v != 0.0 && !(1e-3..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
 }
 
 const fn info(name: &'static str, option_type: OptionType, doc: &'static str) -> OptionInfo {
@@ -81,6 +107,8 @@ const fn info(name: &'static str, option_type: OptionType, doc: &'static str) ->
         option_type,
         group: OptionGroup::Regions,
         doc,
+        min: 0.0,
+        max: 0.0,
     }
 }
 
@@ -90,6 +118,8 @@ const fn p2p(name: &'static str, option_type: OptionType, doc: &'static str) -> 
         option_type,
         group: OptionGroup::Pointwise,
         doc,
+        min: 0.0,
+        max: 0.0,
     }
 }
 
@@ -126,167 +156,205 @@ pub const OPTIONS: &[OptionInfo] = &[
         "k_min",
         Int,
         "smallest number of joint clusters tried (paper: 5)",
-    ),
+    )
+    .range(2.0, 100.0),
     info(
         "k_max",
         Int,
         "largest number of joint clusters tried (paper: 10)",
-    ),
+    )
+    .range(2.0, 100.0),
     info(
         "kmeans_restarts",
         Int,
         "k-means++ starts per k; the lowest cost is kept",
-    ),
+    )
+    .range(1.0, 1000.0),
     info(
         "max_regions",
         Int,
         "graphs with more regions than this are not accepted",
-    ),
+    )
+    .range(1.0, 10_000.0),
     info(
         "min_region_area",
         Float,
         "regions below this fraction of the area are merged into a neighbour",
-    ),
+    )
+    .range(0.0, 0.49),
     info(
         "seed",
         Int,
         "seed of every random choice (k-means++, eigensolver start, local search)",
-    ),
-    info("hks_times", Int, "number of heat kernel signature times"),
-    info("hks_t_min", Float, "smallest HKS time (unit-area shape)"),
-    info("hks_t_max", Float, "largest HKS time (unit-area shape)"),
-    info("hks_log", Bool, "use the logarithm of the HKS"),
-    info("eigenpairs", Int, "number of Laplacian eigenpairs"),
+    )
+    .range(i64::MIN as f64, u64::MAX as f64),
+    info("hks_times", Int, "number of heat kernel signature times").range(1.0, 100.0),
+    info("hks_t_min", Float, "smallest HKS time (unit-area shape)").range(1e-6, 1e3),
+    info("hks_t_max", Float, "largest HKS time (unit-area shape)").range(1e-6, 1e3),
+    info("hks_log", Bool, "use the logarithm of the HKS").range(0.0, 1.0),
+    info("eigenpairs", Int, "number of Laplacian eigenpairs").range(1.0, 1000.0),
     info(
         "threads",
         Int,
         "threads of the eigensolver (0: all cores); results do not depend on it",
-    ),
+    )
+    .range(0.0, 1024.0),
     info(
         "sigma",
         Float,
         "width of the graph matching's Gaussian affinities",
-    ),
+    )
+    .range(1e-3, 100.0),
     info(
         "histogram_bins",
         Int,
         "bins of the graph-distance histograms",
-    ),
+    )
+    .range(1.0, 1000.0),
     info(
         "gap_ratio",
         Float,
         "a match scoring below ratio x the previous one ends the list",
-    ),
+    )
+    .range(0.0, 1.0),
     info(
         "max_symmetry_order",
         Int,
         "largest number of matches per region",
-    ),
+    )
+    .range(1.0, 64.0),
     info(
         "one_to_one",
         Bool,
         "break symmetries into a one-to-one region correspondence",
-    ),
+    )
+    .range(0.0, 1.0),
     info(
         "exhaustive_limit",
         Int,
         "one-to-one: largest number of combinations searched exhaustively",
-    ),
+    )
+    .range(0.0, 10_000_000.0),
     info(
         "symmetry_restarts",
         Int,
         "one-to-one: local-search restarts above that limit",
-    ),
+    )
+    .range(0.0, 10_000.0),
     info(
         "hks_fallback",
         Bool,
         "second try with HKS from a smaller time when the first leaves area unmatched",
-    ),
+    )
+    .range(0.0, 1.0),
     p2p(
         "p2p_eigenpairs",
         Int,
         "pointwise map: Laplacian eigenpairs per shape (the largest basis any step uses)",
-    ),
+    )
+    .range(2.0, 1000.0),
     p2p(
         "p2p_fmap_size",
         Int,
         "pointwise map: size k of the first functional map (k x k)",
-    ),
+    )
+    .range(2.0, 1000.0),
     p2p(
         "p2p_regions",
         Int,
         "pointwise map: region constraints: 0 none, 1 one-to-one (matches), 2 symmetric (groups)",
-    ),
+    )
+    .range(0.0, 2.0),
     p2p(
         "p2p_region_distances",
         Bool,
         "pointwise map: also constrain by the distance from each matched region",
-    ),
+    )
+    .range(0.0, 1.0),
     p2p(
         "p2p_wks",
         Bool,
         "pointwise map: also constrain by wave kernel signatures (100 energies)",
-    ),
+    )
+    .range(0.0, 1.0),
     p2p(
         "p2p_descriptor_step",
         Int,
         "pointwise map: keep every n-th WKS energy",
-    ),
+    )
+    .range(1.0, 100.0),
     p2p(
         "p2p_laplacian_weight",
         Float,
         "pointwise map: weight of the Laplacian commutativity term",
-    ),
+    )
+    .range(0.0, 1e6),
     p2p(
         "p2p_descriptor_commutativity",
         Float,
         "pointwise map: weight of the descriptor commutativity term (0 = off)",
-    ),
+    )
+    .range(0.0, 1e6),
     p2p(
         "p2p_orientation_term",
         Float,
         "pointwise map: weight of the orientation-preserving term (0 = off)",
-    ),
+    )
+    .range(0.0, 1e6),
     p2p(
         "p2p_refinement",
         Int,
         "pointwise map: refinement: 0 none, 1 zoomout (ZoomOut), 2 icp (spectral ICP)",
-    ),
+    )
+    .range(0.0, 2.0),
     p2p(
         "p2p_zoomout_end",
         Int,
         "pointwise map: ZoomOut's final basis size (at most p2p_eigenpairs)",
-    ),
+    )
+    .range(1.0, 1000.0),
     p2p(
         "p2p_zoomout_step",
         Int,
         "pointwise map: eigenfunctions ZoomOut adds per iteration",
-    ),
+    )
+    .range(1.0, 1000.0),
     p2p(
         "p2p_zoomout_sample",
         Int,
         "pointwise map: vertices per shape ZoomOut iterates on (0: all)",
-    ),
+    )
+    .range(0.0, 100_000_000.0),
     p2p(
         "p2p_icp_iterations",
         Int,
         "pointwise map: largest number of spectral ICP iterations",
-    ),
+    )
+    .range(0.0, 1000.0),
     p2p(
         "p2p_orientation",
         Bool,
         "pointwise map: verify the answer's mirror image as a hypothesis (orientable meshes)",
-    ),
+    )
+    .range(0.0, 1.0),
     p2p(
         "p2p_hypotheses",
         Bool,
         "pointwise map: verify the symmetric groups and single-group alternatives as hypotheses",
-    ),
+    )
+    .range(0.0, 1.0),
     info(
         "verify_hypotheses",
         Bool,
         "regions: choose among one-to-one hypotheses by their refined maps (and give a confidence)",
-    ),
+    )
+    .range(0.0, 1.0),
+    info(
+        "max_vertices",
+        Int,
+        "largest shape accepted, in vertices; a larger one is refused before any work",
+    )
+    .range(32.0, 100_000_000.0),
 ];
 
 /// The option called `name`.
@@ -373,22 +441,34 @@ fn wrong_type(info: &OptionInfo, got: OptionType) -> Error {
     }
 }
 
-fn to_usize(info: &OptionInfo, value: i64) -> Result<usize> {
-    usize::try_from(value).map_err(|_| Error::InvalidParameter {
+fn out_of_range(info: &OptionInfo, value: impl std::fmt::Display) -> Error {
+    Error::InvalidParameter {
         name: info.name,
-        reason: format!("must be a non-negative integer, got {value}"),
-    })
+        reason: format!("must lie in {}, got {value}", info.range_text()),
+    }
 }
 
+/// An integer within the option's range.
+fn to_usize(info: &OptionInfo, value: i64) -> Result<usize> {
+    let in_range = (info.min..=info.max).contains(&(value as f64));
+    match usize::try_from(value) {
+        Ok(v) if in_range => Ok(v),
+        _ => Err(out_of_range(info, value)),
+    }
+}
+
+/// A finite float within the option's range.
 fn to_finite(info: &OptionInfo, value: f64) -> Result<f64> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(Error::InvalidParameter {
+    if !value.is_finite() {
+        return Err(Error::InvalidParameter {
             name: info.name,
             reason: format!("must be finite, got {value}"),
-        })
+        });
     }
+    if !(info.min..=info.max).contains(&value) {
+        return Err(out_of_range(info, number_text(value)));
+    }
+    Ok(value)
 }
 
 /// The option called `name`, of type `value` (if given) and of `group`.
@@ -414,7 +494,33 @@ fn checked_info(
     }
 }
 
+/// Checks that every option of `group` read by `value_of` lies in its range (for values
+/// set directly in the parameter structs, which [`Params::set_option`] did not see).
+fn check_ranges(group: OptionGroup, value_of: impl Fn(&str) -> Result<OptionValue>) -> Result<()> {
+    for info in OPTIONS
+        .iter()
+        .filter(|o| o.group == group && o.name != "seed")
+    {
+        match value_of(info.name)? {
+            OptionValue::Int(v) => {
+                to_usize(info, v)?;
+            }
+            OptionValue::Float(v) => {
+                to_finite(info, v)?;
+            }
+            OptionValue::Bool(_) => {}
+        }
+    }
+    Ok(())
+}
+
 impl Params {
+    /// Checks that every option's value lies in its documented range
+    /// ([`OptionInfo::min`], [`OptionInfo::max`]); called by [`Params::validate`].
+    pub fn check_option_ranges(&self) -> Result<()> {
+        check_ranges(OptionGroup::Regions, |name| self.option(name))
+    }
+
     /// Sets the option `name` (one of [`OptionGroup::Regions`]). Errors with
     /// [`Error::UnknownOption`] for a name not in [`OPTIONS`], and with
     /// [`Error::InvalidParameter`] for a pointwise option (see [`Options`]), a value of the
@@ -444,6 +550,7 @@ impl Params {
                     "max_symmetry_order" => self.matching.max_symmetry_order = v,
                     "exhaustive_limit" => self.symmetry.exhaustive_limit = v,
                     "symmetry_restarts" => self.symmetry.restarts = v,
+                    "max_vertices" => self.eigen.max_vertices = v,
                     other => unreachable!("integer option {other} has no field"),
                 }
             }
@@ -498,6 +605,7 @@ impl Params {
             "symmetry_restarts" => int(self.symmetry.restarts),
             "hks_fallback" => OptionValue::Bool(self.fallback.is_some()),
             "verify_hypotheses" => OptionValue::Bool(self.verify_hypotheses),
+            "max_vertices" => int(self.eigen.max_vertices),
             other => unreachable!("option {other} has no field"),
         })
     }
@@ -557,6 +665,7 @@ impl Options {
     /// Checks both sets of parameters ([`Params::validate`], [`PointwiseParams::validate`]).
     pub fn validate(&self) -> Result<()> {
         self.params.validate()?;
+        check_ranges(OptionGroup::Pointwise, |name| self.option(name))?;
         self.pointwise.validate()
     }
 
@@ -690,8 +799,12 @@ mod tests {
                     };
                     OptionValue::Int((v + 1) % 3)
                 }
-                OptionType::Int => OptionValue::Int(3 + i as i64),
-                OptionType::Float => OptionValue::Float(0.125 + i as f64),
+                OptionType::Int => {
+                    OptionValue::Int((info.min as i64 + 1 + i as i64).min(info.max as i64))
+                }
+                OptionType::Float => {
+                    OptionValue::Float(info.min + (info.max - info.min) / (2.0 + i as f64))
+                }
                 OptionType::Bool => {
                     let OptionValue::Bool(b) = options.option(info.name).unwrap() else {
                         panic!("{} is not a bool", info.name)
@@ -938,7 +1051,7 @@ mod tests {
     #[test]
     fn orientation_is_the_pointwise_params_switch() {
         let last = OPTIONS.last().unwrap();
-        assert_eq!((last.name, last.option_type), ("verify_hypotheses", Bool));
+        assert_eq!((last.name, last.option_type), ("max_vertices", Int));
         assert!(Options::default().pointwise().hypotheses);
         let mut options = Options::default();
         assert_eq!(

@@ -142,7 +142,7 @@ impl Failure {
 
 impl From<Error> for Failure {
     fn from(error: Error) -> Self {
-        let status = match &error {
+        let status = match error.innermost() {
             Error::NonFiniteCoordinate { .. } => ScStatus::NonFiniteCoordinate,
             Error::FaceIndexOutOfRange { .. } => ScStatus::FaceIndexOutOfRange,
             Error::FaceTooSmall { .. } => ScStatus::FaceTooSmall,
@@ -153,6 +153,7 @@ impl From<Error> for Failure {
             Error::Numerical { .. } => ScStatus::NumericalFailure,
             Error::Cancelled => ScStatus::Cancelled,
             Error::UnknownOption { .. } => ScStatus::UnknownOption,
+            Error::InShape { .. } => unreachable!("innermost is never InShape"),
         };
         Failure::new(status, error.to_string())
     }

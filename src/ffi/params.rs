@@ -265,6 +265,19 @@ pub extern "C" fn sc_option_type(index: usize) -> u32 {
         })
 }
 
+/// Smallest accepted value of option `index` (0 for a bool); NaN past the end. A value
+/// outside `[sc_option_min, sc_option_max]` is refused with `SC_STATUS_INVALID_PARAMETER`.
+#[no_mangle]
+pub extern "C" fn sc_option_min(index: usize) -> f64 {
+    OPTIONS.get(index).map_or(f64::NAN, |o| o.min)
+}
+
+/// Largest accepted value of option `index` (1 for a bool); NaN past the end.
+#[no_mangle]
+pub extern "C" fn sc_option_max(index: usize) -> f64 {
+    OPTIONS.get(index).map_or(f64::NAN, |o| o.max)
+}
+
 /// The region parameters behind a nullable handle: NULL means the defaults.
 pub(crate) unsafe fn params_or_default(params: *const ScParams) -> Params {
     params

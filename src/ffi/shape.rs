@@ -248,7 +248,8 @@ pub unsafe extern "C" fn sc_shape_new_point_cloud_f32(
 /// `SC_STATUS_FILE_ERROR` names the file and the problem.
 ///
 /// # Safety
-/// `path` must be a NUL-terminated UTF-8 string; `out_shape` must be writable.
+/// `path` must be a NUL-terminated string (UTF-8; on Unix any bytes, as the file system
+/// takes them); `out_shape` must be writable.
 #[no_mangle]
 pub unsafe extern "C" fn sc_shape_read(
     path: *const c_char,
@@ -257,13 +258,27 @@ pub unsafe extern "C" fn sc_shape_read(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_shape, "out_shape")?;
-        let path = input_str(path, "path")?;
-        let shape = Shape::read(
-            std::path::Path::new(path),
-            ReadAs::point_cloud_when(as_point_cloud),
-        )?;
+        let path = input_path(path, "path")?;
+        let shape = Shape::read(&path, ReadAs::point_cloud_when(as_point_cloud))?;
         give_handle(out_shape, ScShape { shape })
     })
+}
+
+/// A path from C: any bytes on Unix (file names need not be UTF-8), UTF-8 elsewhere.
+unsafe fn input_path(ptr: *const c_char, name: &str) -> FfiResult<std::path::PathBuf> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        if ptr.is_null() {
+            return Err(Failure::null(name));
+        }
+        let bytes = std::ffi::CStr::from_ptr(ptr).to_bytes();
+        Ok(std::ffi::OsStr::from_bytes(bytes).into())
+    }
+    #[cfg(not(unix))]
+    {
+        input_str(ptr, name).map(std::path::PathBuf::from)
+    }
 }
 
 /// A generated figure (closed mesh, for tests and demos): `kind` is `"humanoid"`,

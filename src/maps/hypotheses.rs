@@ -480,7 +480,11 @@ pub fn full_consistency(a: &Shape, (faces_a, faces_b): &OrientedFaces, p2p_ba: &
     let normals_a = vertex_normals(a.vertices(), faces_a);
     let (mut kept, mut total) = (0usize, 0usize);
     for t in faces_b {
-        let turn = signed_turn(a.vertices(), t.map(|v| p2p_ba[v as usize] as usize), &normals_a);
+        let turn = signed_turn(
+            a.vertices(),
+            t.map(|v| p2p_ba[v as usize] as usize),
+            &normals_a,
+        );
         if turn != 0.0 {
             total += 1;
             kept += usize::from(turn > 0.0);

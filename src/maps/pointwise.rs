@@ -422,9 +422,8 @@ fn verified(
     // A close call is decided at full resolution, where the meshes' orientation is known.
     let mut chosen_map = None;
     if let (Some(rival), Some(faces)) = (verdict.close_call(), faces) {
-        let [chosen_p2p, rival_p2p] = [verdict.chosen, rival].map(|h| {
-            fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b)
-        });
+        let [chosen_p2p, rival_p2p] = [verdict.chosen, rival]
+            .map(|h| fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b));
         let consistency = (
             hypotheses::full_consistency(a, faces, &chosen_p2p),
             hypotheses::full_consistency(a, faces, &rival_p2p),
@@ -703,10 +702,12 @@ impl PointwiseCorrespondence {
             n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
             ..params.eigen.clone()
         };
-        let basis_a = Eigenbasis::compute_with_progress(a, &eigen, progress)?;
+        let basis_a =
+            Eigenbasis::compute_with_progress(a, &eigen, progress).map_err(|e| e.in_shape('A'))?;
         let eigenbasis_a = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let basis_b = Eigenbasis::compute_with_progress(b, &eigen, progress)?;
+        let basis_b =
+            Eigenbasis::compute_with_progress(b, &eigen, progress).map_err(|e| e.in_shape('B'))?;
         let eigenbasis_b = t.elapsed().as_secs_f64();
         let (regions, map) =
             regions_and_map((a, &basis_a), (b, &basis_b), params, pointwise, progress)?;

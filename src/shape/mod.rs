@@ -886,11 +886,28 @@ fn representatives(vertices: &[[f64; 3]], active: &[u32]) -> Vec<u32> {
 }
 
 /// Area of triangle `t`.
+///
+/// The edges are scaled by a power of two before the cross product (exact, so the result is
+/// bit-identical for ordinary sizes), so a tiny or huge shape (a 1e-100 scale: issue 19)
+/// does not underflow or overflow in the squared lengths.
 pub fn triangle_area(vertices: &[[f64; 3]], t: &[u32; 3]) -> f64 {
     let [a, b, c] = t.map(|i| vertices[i as usize]);
     let u = sub(&b, &a);
     let v = sub(&c, &a);
-    0.5 * norm(&cross(&u, &v))
+    let largest = u.iter().chain(&v).fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = power_of_two_near(largest);
+    let (u, v) = (u.map(|x| x / scale), v.map(|x| x / scale));
+    0.5 * norm(&cross(&u, &v)) * scale * scale
+}
+
+/// A power of two within a factor 2 of `x` (1 for 0 or a non-finite `x`): dividing by it
+/// is exact.
+pub fn power_of_two_near(x: f64) -> f64 {
+    if x > 0.0 && x.is_finite() {
+        2f64.powi(x.log2().floor() as i32)
+    } else {
+        1.0
+    }
 }
 
 /// Corners `(min, max)` of the axis-aligned bounding box of `points` (infinite for none).

@@ -155,11 +155,27 @@ pub fn wks(basis: &Eigenbasis, params: &WksParams) -> Result<Mat<f64>> {
 const ZERO_EIGENVALUE: f64 = 1e-9;
 
 /// `(Phi .* Phi) W`: squared eigenvectors combined with per-eigenvalue weights.
+/// `out[v, j] = sum_i phi_i(v)^2 weights[i, j]`, summed in the order of `i` for every
+/// vertex: a matrix product whose blocking (and so its rounding) would depend on the
+/// number of threads (issue 19: descriptors differed in the last digits between 1 and 2
+/// threads).
 fn squared_vectors_times(basis: &Eigenbasis, weights: &Mat<f64>) -> Mat<f64> {
-    let squared = Mat::from_fn(basis.vectors.nrows(), basis.len(), |v, i| {
-        basis.vectors[(v, i)].powi(2)
-    });
-    &squared * weights
+    use rayon::prelude::*;
+    let (n, k, t) = (basis.vectors.nrows(), basis.len(), weights.ncols());
+    let rows: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|v| {
+            let mut row = vec![0.0; t];
+            for i in 0..k {
+                let squared = basis.vectors[(v, i)].powi(2);
+                for (j, out) in row.iter_mut().enumerate() {
+                    *out += squared * weights[(i, j)];
+                }
+            }
+            row
+        })
+        .collect();
+    Mat::from_fn(n, t, |v, j| rows[v][j])
 }
 
 /// `n` values from `a` to `b` evenly spaced in the logarithm.

@@ -43,6 +43,9 @@ pub struct EigenParams {
     /// Threads for the dense matrix products (0 = all available). The result does not depend
     /// on it.
     pub threads: usize,
+    /// Largest shape accepted, in vertices ([`DEFAULT_MAX_VERTICES`]): a larger shape is
+    /// refused before the Laplacian is built.
+    pub max_vertices: usize,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -57,10 +60,41 @@ impl Default for EigenParams {
             block_size: 4,
             seed: 0x5eed,
             threads: 0,
+            max_vertices: DEFAULT_MAX_VERTICES,
             non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
+
+/// Default [`EigenParams::max_vertices`]: 2 million vertices. Measured (issue 19): a
+/// 300K-vertex pair took 289 s and 1.47 GB on a 2-core machine, so 2M is about 10 GB and
+/// half an hour, the most a desktop can do; larger shapes should be simplified first.
+pub const DEFAULT_MAX_VERTICES: usize = 2_000_000;
+
+/// The threads the dense products use: `threads` (0: all) clamped to the machine's cores,
+/// so that a huge value neither spins nor oversubscribes.
+pub fn effective_threads(threads: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if threads == 0 {
+        cores
+    } else {
+        threads.min(cores)
+    }
+}
+
+/// Fixes faer's global parallelism (its matrix products and dense decompositions) to the
+/// machine's cores, once per process. faer splits work by its `Par`'s thread count and the
+/// split changes the rounding; its default, `Par::rayon(0)`, takes the size of the current
+/// rayon pool, so results differed in the last digits between RAYON_NUM_THREADS=1 and 2
+/// (issue 19). Fixed, they are bit-identical for any pool size on one machine.
+pub fn fix_faer_parallelism() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| faer::set_global_parallelism(Par::rayon(effective_threads(0))));
+}
+
+/// Most eigenpairs computed (the range of the options `eigenpairs` and `p2p_eigenpairs`):
+/// an n x 1000 basis of a 2M-vertex shape is 16 GB.
+pub const MAX_EIGENPAIRS: usize = 1000;
 
 /// Below this many active vertices the dense eigensolver is used.
 const DENSE_LIMIT: usize = 600;
@@ -92,6 +126,7 @@ impl Eigenbasis {
         progress: &mut dyn Progress,
     ) -> Result<Eigenbasis> {
         check(progress, Stage::Laplacian, 0.0)?;
+        check_size(shape, params)?;
         let laplacian = Laplacian::new(shape)?;
         check(progress, Stage::Laplacian, 1.0)?;
         let (values, compact) =
@@ -136,6 +171,53 @@ impl EigenParams {
     }
 }
 
+/// Bytes the eigensolver needs at most for `n` vertices: the Lanczos basis (up to
+/// `6k + 20b` vectors) and the eigenvectors, 8 bytes a value.
+pub fn eigensolver_bytes(n: usize, params: &EigenParams) -> u64 {
+    let k = params.n_eigenpairs.min(n) as u64;
+    let vectors = (6 * k + 20 * params.block_size as u64).min(n as u64) + 2 * k;
+    n as u64 * vectors * 8
+}
+
+/// The memory the system can give now (`MemAvailable`), where it says (Linux).
+fn available_bytes() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_ascii_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses a shape above [`EigenParams::max_vertices`], or one whose eigenbasis needs more
+/// memory than the system has, before anything is allocated.
+fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
+    let n = shape.active_vertices().len();
+    let needed = eigensolver_bytes(n, params);
+    if let Some(available) = available_bytes().filter(|&a| needed > a) {
+        let gb = |b: u64| b as f64 / 1e9;
+        return Err(Error::InvalidParameter {
+            name: "eigenpairs",
+            reason: format!(
+                "{} eigenpairs of a {n}-vertex shape need about {:.1} GB, more than the \
+                 {:.1} GB available; ask for fewer eigenpairs or simplify the shape",
+                params.n_eigenpairs,
+                gb(needed),
+                gb(available)
+            ),
+        });
+    }
+    if n > params.max_vertices {
+        return Err(Error::InvalidParameter {
+            name: "max_vertices",
+            reason: format!(
+                "the shape has {n} vertices, more than max_vertices = {}; simplify it or \
+                 raise max_vertices",
+                params.max_vertices
+            ),
+        });
+    }
+    Ok(())
+}
+
 fn validate(params: &EigenParams) -> Result<()> {
     let bad = |name, reason: &str| {
         Err(Error::InvalidParameter {
@@ -143,8 +225,11 @@ fn validate(params: &EigenParams) -> Result<()> {
             reason: reason.to_string(),
         })
     };
-    if params.n_eigenpairs == 0 {
-        return bad("n_eigenpairs", "must be at least 1");
+    if params.n_eigenpairs == 0 || params.n_eigenpairs > MAX_EIGENPAIRS {
+        return bad(
+            "n_eigenpairs",
+            "must lie in [1, 1000] (the `eigenpairs` option's range)",
+        );
     }
     if !(params.shift > 0.0 && params.shift.is_finite()) {
         return bad("shift", "must be a positive finite number");
@@ -166,12 +251,12 @@ pub fn eigenpairs(
     progress: &mut dyn Progress,
 ) -> Result<(Vec<f64>, Mat<f64>)> {
     validate(params)?;
+    fix_faer_parallelism();
     let n = laplacian.len();
     let k = params.n_eigenpairs.min(n);
-    let par = if params.threads == 1 {
-        Par::Seq
-    } else {
-        Par::rayon(params.threads)
+    let par = match effective_threads(params.threads) {
+        1 => Par::Seq,
+        threads => Par::rayon(threads),
     };
     let (mut values, mut vectors) = if n <= DENSE_LIMIT || 3 * k + 4 * params.block_size >= n {
         dense_eigenpairs(laplacian, k)?

@@ -58,17 +58,34 @@ impl Laplacian {
     /// The Laplacian of a triangulation made by [`triangulation`] (so that callers that
     /// also need the triangles and their lengths build them once).
     pub(crate) fn from_triangulation(t: &Triangulation) -> Result<Laplacian> {
+        // Cotangent weights do not change with scale and the mass scales by s^2, so a shape
+        // far from unit size (1e-100: its areas underflow) is computed with its lengths
+        // divided by a power of two (exact) and its area scaled back (issue 19).
+        let longest = t.lengths.iter().flatten().fold(0.0f64, |m, l| m.max(*l));
+        let scale = if (1e-50..1e50).contains(&longest) {
+            1.0
+        } else {
+            crate::shape::power_of_two_near(longest)
+        };
+        let scaled: Vec<[f64; 3]>;
+        let lengths = if scale == 1.0 {
+            &t.lengths
+        } else {
+            scaled = t.lengths.iter().map(|l| l.map(|x| x / scale)).collect();
+            &scaled
+        };
         let (stiffness, mut mass) =
-            cotan_from_lengths(t.positions.len(), &t.triangles, &t.lengths, t.weight);
-        let input_area: f64 = mass.iter().sum();
+            cotan_from_lengths(t.positions.len(), &t.triangles, lengths, t.weight);
+        let input_area: f64 = mass.iter().sum::<f64>() * scale * scale;
         if !(input_area > 0.0 && input_area.is_finite()) {
             return Err(Error::ZeroArea {
                 detail: format!("the Laplacian's total mass is {input_area}"),
             });
         }
-        let floor = MASS_FLOOR * input_area / mass.len() as f64;
+        let scaled_area = input_area / (scale * scale);
+        let floor = MASS_FLOOR * scaled_area / mass.len() as f64;
         for m in &mut mass {
-            *m = m.max(floor) / input_area;
+            *m = m.max(floor) / scaled_area;
         }
         Ok(Laplacian {
             stiffness,

@@ -139,6 +139,50 @@ static void test_options(void) {
     sc_params_free(NULL);
 }
 
+/* Issue 19: every option at extreme values (0, -1, 1e12, NaN, +-inf, 1e300) gives OK or
+   INVALID_PARAMETER naming that option, never PANIC or an abort; the range functions agree. */
+static void test_option_extremes(void) {
+    static const double extremes[] = {0.0, -1.0, 1e12, 1e300, -1e300};
+    size_t n = sc_option_count(), i, j;
+    sc_params *params = NULL;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK(isnan(sc_option_min(n)) && isnan(sc_option_max(n)), "range past the end is NaN");
+    for (i = 0; i < n; i++) {
+        const char *name = sc_option_name(i);
+        double lo = sc_option_min(i), hi = sc_option_max(i);
+        CHECK(lo <= hi, "%s: range [%g, %g]", name, lo, hi);
+        for (j = 0; j < sizeof extremes / sizeof extremes[0] + 3; j++) {
+            double v = j < 5 ? extremes[j] : j == 5 ? NAN : j == 6 ? INFINITY : hi * 2.0 + 1.0;
+            sc_status st;
+            if (sc_option_type(i) == SC_OPTION_INT) {
+                if (!(fabs(v) < 9e18))
+                    continue;
+                st = sc_params_set_int(params, name, (int64_t)v);
+            } else if (sc_option_type(i) == SC_OPTION_DOUBLE) {
+                st = sc_params_set_double(params, name, v);
+            } else {
+                continue;
+            }
+            CHECK(st == SC_STATUS_OK || st == SC_STATUS_INVALID_PARAMETER, "%s = %g: %s", name,
+                  v, sc_status_str(st));
+            if (st == SC_STATUS_INVALID_PARAMETER)
+                CHECK(strstr(sc_last_error(), name) != NULL, "%s = %g: %s", name, v,
+                      sc_last_error());
+            else
+                CHECK(strcmp(name, "seed") == 0 || (v >= lo && v <= hi),
+                      "%s = %g accepted outside [%g, %g]", name, v, lo, hi);
+        }
+    }
+    /* The reproducers of issue 19, item 3: refused at once, naming the option. */
+    CHECK_STATUS(sc_params_set_int(params, "histogram_bins", 1000000000000LL),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_int(params, "hks_times", 100000000), SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "hks_times") != NULL, "%s", sc_last_error());
+    CHECK_STATUS(sc_params_set_double(params, "sigma", 1e300), SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "sigma") != NULL, "%s", sc_last_error());
+    sc_params_free(params);
+}
+
 /* ------------------------------------------------------------------------ shape errors */
 
 static void test_shape_errors(void) {
@@ -685,7 +729,6 @@ static void test_pointwise_errors(void) {
     } bad[] = {
         {"p2p_fmap_size", 120},   /* above p2p_eigenpairs (100) */
         {"p2p_zoomout_end", 150}, /* above p2p_eigenpairs */
-        {"p2p_zoomout_step", 0},
         {"p2p_regions", SC_P2P_REGIONS_NONE}, /* and no WKS: nothing constrains the map */
         {"k_max", 3},                         /* below k_min */
     };
@@ -694,6 +737,11 @@ static void test_pointwise_errors(void) {
     CHECK_STATUS(sc_pointwise_map(a, NULL, NULL, NULL, NULL, &p), SC_STATUS_NULL_ARGUMENT);
     CHECK_STATUS(sc_pointwise_map(a, a, NULL, NULL, NULL, NULL), SC_STATUS_NULL_ARGUMENT);
     CHECK(strstr(sc_last_error(), "out_pointwise") != NULL, "message: %s", sc_last_error());
+    /* A value out of its own range is refused when set (issue 19). */
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "p2p_zoomout_step", 0), SC_STATUS_INVALID_PARAMETER);
+    sc_params_free(params);
+    params = NULL;
     for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
         CHECK_STATUS(sc_params_set_int(params, bad[i].name, bad[i].value), SC_STATUS_OK);
@@ -962,12 +1010,40 @@ static void test_concurrency(void) {
     sc_shape_free(b);
 }
 
+/* Issue 19, item 7: kmeans_restarts at its largest (minutes of work) stops promptly. */
+static bool cancel_in_segmentation(void *userdata, uint32_t stage, float fraction) {
+    double *due = (double *)userdata;
+    (void)fraction;
+    if (stage != SC_STAGE_SEGMENTATION)
+        return true;
+    if (*due == 0.0)
+        *due = now_seconds() + 0.3;
+    return now_seconds() < *due;
+}
+
+static void test_cancel_huge_restarts(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 1);
+    sc_params *params = NULL;
+    sc_correspondence *c = NULL;
+    double due = 0.0, latency;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "kmeans_restarts", 1000), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, b, params, cancel_in_segmentation, &due, &c), SC_STATUS_CANCELLED);
+    latency = now_seconds() - due;
+    CHECK(due > 0.0 && latency < 2.0, "stopped %.3f s after the cancel", latency);
+    CHECK(c == NULL, "no output when cancelled");
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
 int main(void) {
     const char *q = getenv("SHAPECORR_TEST_QUICK");
     quick = q != NULL && strcmp(q, "1") == 0;
     test_version();
     test_status_text();
     test_options();
+    test_option_extremes();
     test_shape_errors();
     test_repairs();
     test_match_errors();
@@ -975,6 +1051,7 @@ int main(void) {
     test_point_cloud();
     test_unverified_has_no_confidence();
     test_cancellation();
+    test_cancel_huge_restarts();
     test_symmetry();
     test_pointwise_options();
     test_pointwise_errors();

@@ -23,6 +23,9 @@ works (ctypes does).
 import ctypes
 import functools
 import math
+import os
+import signal
+import threading
 import weakref
 
 import numpy as np
@@ -91,13 +94,34 @@ class _Handle:
     _free = None
 
     def __init__(self, pointer):
-        self._as_parameter_ = ctypes.c_void_p(pointer)
+        self._pointer = ctypes.c_void_p(pointer)
         # finalize keeps a reference to the free function, so it works at exit too.
-        self._finalizer = weakref.finalize(self, type(self)._free, pointer)
+        self._finalizer = weakref.finalize(self, type(self)._free, self._pointer)
+
+    def _handle_pointer(self):
+        """The C pointer; ValueError once :meth:`close` freed it (never a dangling one)."""
+        if not self._finalizer.alive:
+            raise ValueError(f"this {type(self).__name__} is closed")
+        return self._pointer
+
+    @property
+    def closed(self):
+        """True once :meth:`close` freed the C object."""
+        return not self._finalizer.alive
 
     def close(self):
-        """Frees the C object now (also done automatically)."""
+        """Frees the C object now (also done automatically); using it afterwards raises
+        ValueError."""
         self._finalizer()
+
+
+def _expect(value, kind, name):
+    """``value`` if it is an open ``kind``: TypeError for anything else (a path, an int, a
+    result where a shape goes), ValueError when closed."""
+    if not isinstance(value, kind):
+        raise TypeError(f"{name} must be a shapecorr.{kind.__name__}, got {type(value).__name__}")
+    value._handle_pointer()
+    return value
 
 
 def _new_handle(constructor, *args):
@@ -129,6 +153,8 @@ class Shape(_Handle):
             coords, ctype = np.ascontiguousarray(coords, dtype=np.float64), ctypes.c_double
             function = functools.partial(_with_flags, lib.sc_shape_new_mesh_repaired, 4, flags)
         tris = np.asarray(triangles)
+        if tris.size and tris.dtype.kind not in "iu":
+            raise TypeError(f"triangle indices must be integers, got {tris.dtype}")
         if tris.size and (tris.ndim != 2 or tris.shape[1] != 3):
             raise ValueError(f"triangles must have shape (m, 3), got {tris.shape}")
         if tris.size and (tris.min() < 0 or tris.max() > np.iinfo(np.uint32).max):
@@ -161,9 +187,11 @@ class Shape(_Handle):
     def read(cls, path, as_point_cloud=False, repair=True):
         """Reads OFF, OBJ, PLY or XYZ; a file without faces gives a point cloud. ``repair``
         as for :meth:`mesh`."""
+        # os.fsencode: str, bytes or path-like, with the file system's encoding; a NUL
+        # inside raises ValueError.
         return cls(
             _new_handle(
-                lib.sc_shape_read_repaired, str(path).encode(), bool(as_point_cloud),
+                lib.sc_shape_read_repaired, os.fsencode(path), bool(as_point_cloud),
                 _repair_flags(repair),
             )
         )
@@ -172,7 +200,9 @@ class Shape(_Handle):
     def figure(cls, kind="humanoid", pose=0, vertices=5000):
         """A generated figure (``"humanoid"``, ``"quadruped"``, ``"star3"``..``"star8"``);
         every pose of a kind and size shares the vertex order (a ground truth)."""
-        return cls(_new_handle(lib.sc_shape_new_figure, kind.encode(), int(pose), int(vertices)))
+        if not isinstance(kind, str):
+            raise TypeError(f"kind must be a str, got {type(kind).__name__}")
+        return cls(_new_handle(lib.sc_shape_new_figure, kind.encode(), pose, vertices))
 
     @property
     def n_vertices(self):
@@ -278,6 +308,10 @@ class _Params(_Handle):
             }[kind]
             if kind == "int" and (isinstance(value, bool) or int(value) != value):
                 raise ShapecorrError(2, f"option `{name}` takes an integer, got {value!r}")
+            if kind == "int" and name == "seed" and 2**63 <= int(value) < 2**64:
+                value = int(value) - 2**64  # a seed takes any 64-bit value
+            if kind == "int" and not -(2**63) <= int(value) < 2**63:
+                raise OverflowError(f"option `{name}`: {value} does not fit in 64 bits")
             if kind == "bool" and not isinstance(value, (bool, np.bool_)):
                 raise ShapecorrError(2, f"option `{name}` takes True or False, got {value!r}")
             converted = {"int": int, "float": float, "bool": bool}[kind](value)
@@ -308,27 +342,55 @@ def options():
 
 
 class _Progress:
-    """Wraps a Python callable ``progress(stage_name, fraction) -> bool`` (returning False
-    cancels); an exception inside it cancels the call and is raised afterwards."""
+    """Wraps a Python callable ``progress(stage_name, fraction)``: a falsy return other than
+    None (``False``, ``0``, ``np.False_``) cancels, None or a truthy value goes on; an
+    exception inside it cancels the call and is raised afterwards. Ctrl-C (SIGINT) during
+    the call, with or without a callback, cancels it and raises KeyboardInterrupt: while
+    the call runs in the main thread, SIGINT only sets a flag that the next progress report
+    (at least every 0.2 s) turns into a cancel."""
 
     def __init__(self, progress):
         self.error = None
         self.user = progress
+        self.interrupted = False
 
         def call(_userdata, stage, fraction):
+            if self.interrupted:
+                return False
+            if self.user is None:
+                return True
             try:
                 keep_going = self.user(_lib.STAGE_NAMES.get(stage, str(stage)), float(fraction))
-                return keep_going is not False
+                return keep_going is None or bool(keep_going)
             except BaseException as error:  # noqa: BLE001 - re-raised after the C call
                 self.error = error
                 return False
 
-        self.c_function = _lib.PROGRESS(call) if progress is not None else _lib.PROGRESS()
+        self.c_function = _lib.PROGRESS(call)
 
-    def finish(self, status):
+    def run(self, function, *args):
+        """Calls ``function(*args, c_progress, NULL, out)`` and raises what it ended with."""
+        out = ctypes.c_void_p()
+        previous = None
+        if (
+            threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        ):
+            previous = signal.signal(signal.SIGINT, self._on_sigint)
+        try:
+            status = function(*args, self.c_function, None, ctypes.byref(out))
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
+        if self.interrupted:
+            raise KeyboardInterrupt
         if self.error is not None:
             raise self.error
         _check(status)
+        return out.value
+
+    def _on_sigint(self, _signum, _frame):
+        self.interrupted = True
 
 
 def _confidence(value):
@@ -483,24 +545,20 @@ class Symmetry(_Handle):
 def match(a, b, progress=None, **options):
     """Region correspondence between shapes ``a`` and ``b``. ``options`` are named options
     (``k_min=5, k_max=10, one_to_one=True, ...``; see :func:`options`). ``progress``, if
-    given, is called as ``progress(stage, fraction)`` and cancels by returning False
-    (:class:`ShapecorrError` with status ``CANCELLED``)."""
+    given, is called as ``progress(stage, fraction)`` at least every 0.2 s and cancels by
+    returning a falsy value other than None (``False``, ``0``, ``np.False_``):
+    :class:`ShapecorrError` with status ``CANCELLED``. Ctrl-C cancels and raises
+    KeyboardInterrupt."""
+    _expect(a, Shape, "a"), _expect(b, Shape, "b")
     params = _Params(options)
-    callback = _Progress(progress)
-    out = ctypes.c_void_p()
-    status = lib.sc_match(a, b, params, callback.c_function, None, ctypes.byref(out))
-    callback.finish(status)
-    return Correspondence(out.value)
+    return Correspondence(_Progress(progress).run(lib.sc_match, a, b, params))
 
 
 def detect_symmetry(shape, progress=None, **options):
     """Groups of mutually symmetric regions of one shape (arguments as :func:`match`)."""
+    _expect(shape, Shape, "shape")
     params = _Params(options)
-    callback = _Progress(progress)
-    out = ctypes.c_void_p()
-    status = lib.sc_symmetry_detect(shape, params, callback.c_function, None, ctypes.byref(out))
-    callback.finish(status)
-    return Symmetry(out.value)
+    return Symmetry(_Progress(progress).run(lib.sc_symmetry_detect, shape, params))
 
 
 class PointwiseMap(_Handle):
@@ -578,9 +636,6 @@ def pointwise_map(a, b, progress=None, **options):
     ``p2p_refinement=1`` (0 none, 1 ZoomOut, 2 ICP), ``p2p_wks=False``, ...; see
     :func:`options`). ``progress`` as for :func:`match`; the last stage is
     ``"pointwise_map"``. Returns a :class:`PointwiseMap`."""
+    _expect(a, Shape, "a"), _expect(b, Shape, "b")
     params = _Params(options)
-    callback = _Progress(progress)
-    out = ctypes.c_void_p()
-    status = lib.sc_pointwise_map(a, b, params, callback.c_function, None, ctypes.byref(out))
-    callback.finish(status)
-    return PointwiseMap(out.value)
+    return PointwiseMap(_Progress(progress).run(lib.sc_pointwise_map, a, b, params))

@@ -7,8 +7,10 @@ Where the library comes from, in order:
 """
 
 import ctypes
+import operator
 import os
 import sys
+import threading
 from pathlib import Path
 
 #: The C ABI version this binding was written for (``SC_ABI_VERSION`` in shapecorr.h).
@@ -61,33 +63,92 @@ c_f64p = ctypes.POINTER(ctypes.c_double)
 c_f32p = ctypes.POINTER(ctypes.c_float)
 c_i64p = ctypes.POINTER(ctypes.c_int64)
 c_boolp = ctypes.POINTER(ctypes.c_bool)
-c_str = ctypes.c_char_p
-handle = ctypes.c_void_p
 handle_out = ctypes.POINTER(ctypes.c_void_p)
 status = ctypes.c_uint32
+
+# Checked argument types: what ctypes would silently truncate, wrap or dereference raises
+# instead. ctypes reports a failed conversion as ArgumentError; the wrappers installed below
+# re-raise the original TypeError, ValueError or OverflowError.
+_argument_error = threading.local()
+
+
+def _refuse(error):
+    _argument_error.value = error
+    raise error
+
+
+class handle:
+    """A shapecorr object (or None for NULL): anything else raises TypeError, a closed
+    object ValueError, so no stray pointer ever reaches the library."""
+
+    @classmethod
+    def from_param(cls, obj):
+        if obj is None or isinstance(obj, ctypes.c_void_p):
+            return obj
+        pointer = getattr(obj, "_handle_pointer", None)
+        if pointer is None:
+            _refuse(TypeError(f"expected a shapecorr object (e.g. a Shape), got {type(obj).__name__}"))
+        try:
+            return pointer()
+        except ValueError as error:
+            _refuse(error)
+
+
+def _checked_int(ctype, low, high):
+    class checked:
+        @classmethod
+        def from_param(cls, value):
+            try:
+                value = operator.index(value)
+            except TypeError:
+                _refuse(TypeError(f"expected an integer, got {type(value).__name__} {value!r}"))
+            if not low <= value <= high:
+                _refuse(OverflowError(f"{value} is out of range [{low}, {high}]"))
+            return ctype(value)
+
+    return checked
+
+
+u32_arg = _checked_int(ctypes.c_uint32, 0, 2**32 - 1)
+c_i64 = _checked_int(ctypes.c_int64, -(2**63), 2**63 - 1)
+
+
+class c_str:
+    """A NUL-terminated byte string (or None): a NUL inside raises ValueError rather than
+    cutting the string."""
+
+    @classmethod
+    def from_param(cls, value):
+        if value is None:
+            return None
+        if not isinstance(value, bytes):
+            _refuse(TypeError(f"expected bytes, got {type(value).__name__}"))
+        if b"\0" in value:
+            _refuse(ValueError(f"embedded NUL character in {value!r}"))
+        return ctypes.c_char_p(value)
 
 #: ``bool (*)(void *userdata, uint32_t stage, float fraction)``
 PROGRESS = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float)
 
 #: Every exported function: name -> (restype, argtypes). tests check it against the header.
 FUNCTIONS = {
-    "sc_version": (c_str, []),
+    "sc_version": (ctypes.c_char_p, []),
     "sc_version_major": (c_u32, []),
     "sc_version_minor": (c_u32, []),
     "sc_version_patch": (c_u32, []),
     "sc_abi_version": (c_u32, []),
-    "sc_status_str": (c_str, [c_u32]),
-    "sc_last_error": (c_str, []),
+    "sc_status_str": (ctypes.c_char_p, [u32_arg]),
+    "sc_last_error": (ctypes.c_char_p, []),
     # shapes
     "sc_shape_new_mesh": (status, [c_f64p, c_size_t, c_u32p, c_size_t, handle_out]),
     "sc_shape_new_mesh_f32": (status, [c_f32p, c_size_t, c_u32p, c_size_t, handle_out]),
     "sc_shape_new_point_cloud": (status, [c_f64p, c_size_t, handle_out]),
     "sc_shape_new_point_cloud_f32": (status, [c_f32p, c_size_t, handle_out]),
     "sc_shape_read": (status, [c_str, ctypes.c_bool, handle_out]),
-    "sc_shape_new_figure": (status, [c_str, c_u32, c_u32, handle_out]),
-    "sc_shape_new_mesh_repaired": (status, [c_f64p, c_size_t, c_u32p, c_size_t, c_u32, handle_out]),
-    "sc_shape_new_point_cloud_repaired": (status, [c_f64p, c_size_t, c_u32, handle_out]),
-    "sc_shape_read_repaired": (status, [c_str, ctypes.c_bool, c_u32, handle_out]),
+    "sc_shape_new_figure": (status, [c_str, u32_arg, u32_arg, handle_out]),
+    "sc_shape_new_mesh_repaired": (status, [c_f64p, c_size_t, c_u32p, c_size_t, u32_arg, handle_out]),
+    "sc_shape_new_point_cloud_repaired": (status, [c_f64p, c_size_t, u32_arg, handle_out]),
+    "sc_shape_read_repaired": (status, [c_str, ctypes.c_bool, u32_arg, handle_out]),
     "sc_shape_free": (None, [handle]),
     "sc_shape_n_vertices": (c_size_t, [handle]),
     "sc_shape_n_triangles": (c_size_t, [handle]),
@@ -99,34 +160,36 @@ FUNCTIONS = {
     # parameters
     "sc_params_new": (status, [handle_out]),
     "sc_params_free": (None, [handle]),
-    "sc_params_set_int": (status, [handle, c_str, ctypes.c_int64]),
+    "sc_params_set_int": (status, [handle, c_str, c_i64]),
     "sc_params_set_double": (status, [handle, c_str, ctypes.c_double]),
     "sc_params_set_bool": (status, [handle, c_str, ctypes.c_bool]),
     "sc_params_get_int": (status, [handle, c_str, c_i64p]),
     "sc_params_get_double": (status, [handle, c_str, c_f64p]),
     "sc_params_get_bool": (status, [handle, c_str, c_boolp]),
     "sc_option_count": (c_size_t, []),
-    "sc_option_name": (c_str, [c_size_t]),
-    "sc_option_doc": (c_str, [c_size_t]),
-    "sc_option_type": (c_u32, [c_size_t]),
+    "sc_option_name": (ctypes.c_char_p, [c_size_t]),
+    "sc_option_doc": (ctypes.c_char_p, [c_size_t]),
+    "sc_option_type": (ctypes.c_uint32, [c_size_t]),
+    "sc_option_min": (ctypes.c_double, [c_size_t]),
+    "sc_option_max": (ctypes.c_double, [c_size_t]),
     # correspondence
     "sc_match": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_correspondence_free": (None, [handle]),
     "sc_correspondence_k": (c_u32, [handle]),
-    "sc_correspondence_n_vertices": (c_size_t, [handle, c_u32]),
-    "sc_correspondence_n_regions": (c_size_t, [handle, c_u32]),
-    "sc_correspondence_regions": (status, [handle, c_u32, c_u32p, c_size_t]),
-    "sc_correspondence_n_matches": (c_size_t, [handle, c_u32]),
-    "sc_correspondence_matches": (status, [handle, c_u32, c_u32p, c_size_t]),
-    "sc_correspondence_colors": (status, [handle, c_u32, c_u32, c_u8p, c_size_t]),
+    "sc_correspondence_n_vertices": (c_size_t, [handle, u32_arg]),
+    "sc_correspondence_n_regions": (c_size_t, [handle, u32_arg]),
+    "sc_correspondence_regions": (status, [handle, u32_arg, c_u32p, c_size_t]),
+    "sc_correspondence_n_matches": (c_size_t, [handle, u32_arg]),
+    "sc_correspondence_matches": (status, [handle, u32_arg, c_u32p, c_size_t]),
+    "sc_correspondence_colors": (status, [handle, u32_arg, u32_arg, c_u8p, c_size_t]),
     "sc_correspondence_descriptor_length": (c_size_t, [handle]),
-    "sc_correspondence_region_areas": (status, [handle, c_u32, c_f64p, c_size_t]),
-    "sc_correspondence_region_descriptors": (status, [handle, c_u32, c_f64p, c_size_t]),
-    "sc_correspondence_n_edges": (c_size_t, [handle, c_u32]),
-    "sc_correspondence_edges": (status, [handle, c_u32, c_u32p, c_size_t]),
+    "sc_correspondence_region_areas": (status, [handle, u32_arg, c_f64p, c_size_t]),
+    "sc_correspondence_region_descriptors": (status, [handle, u32_arg, c_f64p, c_size_t]),
+    "sc_correspondence_n_edges": (c_size_t, [handle, u32_arg]),
+    "sc_correspondence_edges": (status, [handle, u32_arg, c_u32p, c_size_t]),
     "sc_correspondence_seconds": (status, [handle, c_str, c_f64p]),
     "sc_correspondence_confidence": (ctypes.c_double, [handle]),
-    "sc_correspondence_warning": (c_str, [handle]),
+    "sc_correspondence_warning": (ctypes.c_char_p, [handle]),
     # symmetry
     "sc_symmetry_detect": (status, [handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_symmetry_free": (None, [handle]),
@@ -139,7 +202,7 @@ FUNCTIONS = {
     # pointwise maps
     "sc_pointwise_map": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_pointwise_free": (None, [handle]),
-    "sc_pointwise_n_vertices": (c_size_t, [handle, c_u32]),
+    "sc_pointwise_n_vertices": (c_size_t, [handle, u32_arg]),
     "sc_pointwise_map_b_to_a": (status, [handle, c_u32p, c_size_t]),
     "sc_pointwise_fmap_rows": (c_size_t, [handle]),
     "sc_pointwise_fmap_cols": (c_size_t, [handle]),
@@ -147,13 +210,32 @@ FUNCTIONS = {
     "sc_pointwise_regions": (status, [handle, handle_out]),
     "sc_pointwise_seconds": (status, [handle, c_str, c_f64p]),
     "sc_pointwise_confidence": (ctypes.c_double, [handle]),
-    "sc_pointwise_warning": (c_str, [handle]),
+    "sc_pointwise_warning": (ctypes.c_char_p, [handle]),
 }
+
+def _raising_the_original(function):
+    """``function``, raising a checked argument's own error instead of ArgumentError."""
+
+    def call(*args):
+        _argument_error.value = None
+        try:
+            return function(*args)
+        except ctypes.ArgumentError:
+            error, _argument_error.value = getattr(_argument_error, "value", None), None
+            if error is None:
+                raise
+            raise error from None
+
+    call.__name__ = function.__name__
+    call.restype, call.argtypes = function.restype, function.argtypes
+    return call
+
 
 for _name, (_restype, _argtypes) in FUNCTIONS.items():
     _function = getattr(lib, _name)
     _function.restype = _restype
     _function.argtypes = _argtypes
+    setattr(lib, _name, _raising_the_original(_function))
 
 if lib.sc_abi_version() != ABI_VERSION:
     raise ImportError(

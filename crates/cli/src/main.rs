@@ -30,6 +30,11 @@ use commands::synth::SynthArgs;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// No progress on stderr. Otherwise progress is a line redrawn on a terminal, or a line
+    /// `shapecorr: progress: STAGE NN% (T s)` at most once a second when stderr is a file
+    /// or a pipe.
+    #[arg(long, global = true)]
+    quiet: bool,
 }
 
 // Parsed once per run: the size difference between variants does not matter.
@@ -70,6 +75,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    output::QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
     // The whole command runs on a worker of one rayon pool: parallel loops called from
     // inside it start without handing work over from a foreign thread, which with many
     // small loops (k-means, Lanczos) cost measurable time in thread wake-ups. Threads come

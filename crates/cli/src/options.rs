@@ -119,7 +119,15 @@ fn help(info: &OptionInfo) -> String {
         .option(info.name)
         .map(|v| value_text(info.name, v))
         .unwrap_or_default();
-    format!("{} [default: {default}]", info.doc)
+    match info.option_type {
+        OptionType::Bool => format!("{} [default: {default}]", info.doc),
+        _ if info.name == "seed" => format!("{} [default: {default}]", info.doc),
+        _ => format!(
+            "{} [default: {default}] [range: {}]",
+            info.doc,
+            info.range_text()
+        ),
+    }
 }
 
 fn invalid(cmd: &Command, message: String) -> clap::Error {
@@ -391,7 +399,7 @@ mod tests {
     fn bad_values_name_the_flag_or_option() {
         for (args, expected) in [
             (&["--k-min", "five"][..], "--k-min"),
-            (&["--k-min", "-1"], "non-negative"),
+            (&["--k-min", "-1"], "must lie in [2, 100], got -1"),
             (&["--one-to-one", "maybe"], "true or false"),
             (&["--set", "nope=1"], "`nope`"),
             (&["--set", "k-max=3"], "did you mean `k_max`"),

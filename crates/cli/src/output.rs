@@ -11,21 +11,57 @@ use shapecorr::progress::{Progress, Stage};
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::{Error, Shape};
 
-/// Prints stage progress on one line of the terminal (nothing when stderr is not one).
-pub struct TerminalProgress;
+/// No progress at all (`--quiet`).
+pub static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// How often progress is written as lines when stderr is not a terminal.
+const LINE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// Stage progress on stderr: on a terminal one line redrawn in place; otherwise (a log
+/// file, a pipe, CI) a line `shapecorr: progress: STAGE NN% (T s)` at most once a second,
+/// the first after a second of work (so a quick command prints none). `--quiet`: nothing.
+pub struct TerminalProgress {
+    started: std::time::Instant,
+    last_line: Option<std::time::Instant>,
+}
+
+impl Default for TerminalProgress {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl TerminalProgress {
+    pub fn new() -> Self {
+        TerminalProgress {
+            started: std::time::Instant::now(),
+            last_line: None,
+        }
+    }
+}
 
 impl Progress for TerminalProgress {
     fn report(&mut self, stage: Stage, fraction: f32) -> bool {
         use std::io::{IsTerminal, Write};
+        if QUIET.load(std::sync::atomic::Ordering::Relaxed) {
+            return true;
+        }
         let mut stderr = std::io::stderr();
+        let stage = format!("{stage:?}");
         if stderr.is_terminal() {
-            let _ = write!(
+            let _ = write!(stderr, "\r{stage:<16} {:>3.0}%", 100.0 * fraction);
+            let _ = stderr.flush();
+            return true;
+        }
+        let since = self.last_line.unwrap_or(self.started).elapsed();
+        if since >= LINE_INTERVAL {
+            self.last_line = Some(std::time::Instant::now());
+            let elapsed = self.started.elapsed().as_secs_f64();
+            let _ = writeln!(
                 stderr,
-                "\r{:<16} {:>3.0}%",
-                format!("{stage:?}"),
+                "shapecorr: progress: {stage} {:.0}% ({elapsed:.0} s)",
                 100.0 * fraction
             );
-            let _ = stderr.flush();
         }
         true
     }
@@ -34,7 +70,7 @@ impl Progress for TerminalProgress {
 /// Ends the progress line, if one was drawn.
 pub fn end_progress_line() {
     use std::io::IsTerminal;
-    if std::io::stderr().is_terminal() {
+    if std::io::stderr().is_terminal() && !QUIET.load(std::sync::atomic::Ordering::Relaxed) {
         eprintln!();
     }
 }

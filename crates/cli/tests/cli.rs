@@ -487,7 +487,7 @@ fn help_lists_one_flag_per_option_of_the_table() {
         ),
     ] {
         let mut flags = help_flags(command);
-        for f in own.iter().chain(&["--set", "--help"]) {
+        for f in own.iter().chain(&["--set", "--help", "--quiet"]) {
             assert!(flags.remove(*f), "{command:?}: {f}");
         }
         assert_eq!(flags, region, "{command:?}");
@@ -498,6 +498,7 @@ fn help_lists_one_flag_per_option_of_the_table() {
     let k_max = OPTIONS.iter().find(|o| o.name == "k_max").unwrap();
     assert!(help.contains(k_max.doc), "{help}");
     assert!(help.contains("[default: 10]"), "{help}");
+    assert!(help.contains("[range: [2, 100]]"), "{help}");
 }
 
 /// `--set k_max=6` and `--k-max 6` reach the method alike: the same options recorded in

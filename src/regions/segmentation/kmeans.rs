@@ -1,6 +1,7 @@
 //! Step 2 (paper, section 4): joint k-means on the stacked descriptors, weighted by area.
 
 use super::*;
+use crate::progress::Cancel;
 
 /// Weighted k-means on the stacked rows of `a` and `b` (paper, section 4, step 2) with the
 /// default distance [`DEFAULT_METRIC`] (the authors use city block with 3 restarts; pass
@@ -254,6 +255,16 @@ fn sample(scores: &[f64], rng: &mut ChaCha8Rng) -> Option<usize> {
 }
 
 pub(super) fn kmeans(points: &Points, params: &KMeansParams) -> JointClustering {
+    kmeans_cancellable(points, params, &Cancel::default()).expect("never cancelled")
+}
+
+/// As [`kmeans`], stopping with [`crate::Error::Cancelled`] between Lloyd iterations once
+/// `cancel` is set.
+pub(super) fn kmeans_cancellable(
+    points: &Points,
+    params: &KMeansParams,
+    cancel: &Cancel,
+) -> crate::Result<JointClustering> {
     let (k, d, n) = (params.k, points.d, points.n());
     assert!(k >= 1, "joint k-means: k must be at least 1");
     assert!(
@@ -263,9 +274,17 @@ pub(super) fn kmeans(points: &Points, params: &KMeansParams) -> JointClustering 
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let mut best: Option<(f64, Vec<f64>, Vec<u32>)> = None;
     for _ in 0..params.restarts {
+        cancel.check()?;
         let centroids = seed_centroids(points, k, params.metric, &mut rng);
-        let (cost, centroids, labels) =
-            lloyd(points, centroids, k, params.metric, params.max_iterations);
+        let (cost, centroids, labels) = lloyd(
+            points,
+            centroids,
+            k,
+            params.metric,
+            params.max_iterations,
+            cancel,
+        );
+        cancel.check()?;
         if best.as_ref().is_none_or(|(c, _, _)| cost < *c) {
             best = Some((cost, centroids, labels));
         }
@@ -291,12 +310,12 @@ pub(super) fn kmeans(points: &Points, params: &KMeansParams) -> JointClustering 
         stacked[s as usize] = new_id[labels[p] as usize];
     }
     let labels_b = stacked.split_off(points.n_a);
-    JointClustering {
+    Ok(JointClustering {
         labels_a: stacked,
         labels_b,
         centroids: Mat::from_fn(k, d, |c, j| centroids[rank[c] * d + j]),
         cost,
-    }
+    })
 }
 
 /// k-means++ seeding (row-major k x d centroids).
@@ -487,12 +506,16 @@ fn lloyd(
     k: usize,
     metric: KMeansMetric,
     max_iterations: usize,
+    cancel: &Cancel,
 ) -> (f64, Vec<f64>, Vec<u32>) {
     let d = points.d;
     let mut state = Assignment::new(points, &centroids, metric);
     let mut medians: Option<Medians> = None;
     let mut moved: Vec<(u32, u32, u32)> = Vec::new();
     for _ in 0..max_iterations {
+        if cancel.check().is_err() {
+            break; // the caller sees the cancel and drops this result
+        }
         let previous = centroids.clone();
         update(
             points,

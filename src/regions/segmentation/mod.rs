@@ -383,6 +383,9 @@ pub fn segment_pair(
     )
 }
 
+/// One value of k tried: its scores, both graphs and the centroids.
+type Tried = (KCandidate, ShapeGraph, ShapeGraph, Mat<f64>);
+
 /// As [`segment_pair`], reporting progress over the values of k and stopping with
 /// [`Error::Cancelled`] when `progress` asks to. The k values run in parallel in batches of
 /// the thread count, with a report (and a chance to cancel) between batches.
@@ -436,24 +439,20 @@ pub fn segment_pair_with_progress(
     };
     let graph_params = params.graph_params();
     let all_k: Vec<usize> = (params.k_min..=params.k_max).collect();
-    let batch = rayon::current_num_threads().max(1);
-    let mut tried: Vec<(KCandidate, ShapeGraph, ShapeGraph, Mat<f64>)> = Vec::new();
-    for (done, ks) in all_k.chunks(batch).enumerate() {
-        let fraction = (done * batch) as f32 / all_k.len() as f32;
-        crate::progress::check(progress, crate::progress::Stage::Segmentation, fraction)?;
-        let results: Vec<(KCandidate, ShapeGraph, ShapeGraph, Mat<f64>)> = ks
-            .par_iter()
-            .map(|&k| {
-                let clustering = kmeans::kmeans(
-                    &points,
-                    &KMeansParams {
-                        k,
-                        restarts: params.kmeans_restarts,
-                        seed: params.seed,
-                        metric: params.metric,
-                        max_iterations: params.kmeans_max_iterations,
-                    },
-                );
+    let tried = crate::progress::polled(
+        progress,
+        crate::progress::Stage::Segmentation,
+        (0.0, 1.0),
+        |cancel| {
+            let try_k = |k: usize| -> Result<Tried> {
+                let kmeans_params = KMeansParams {
+                    k,
+                    restarts: params.kmeans_restarts,
+                    seed: params.seed,
+                    metric: params.metric,
+                    max_iterations: params.kmeans_max_iterations,
+                };
+                let clustering = kmeans::kmeans_cancellable(&points, &kmeans_params, cancel)?;
                 let centroids = clustering.centroids.as_ref();
                 let (graph_a, graph_b) = rayon::join(
                     || {
@@ -478,11 +477,18 @@ pub fn segment_pair_with_progress(
                     },
                 );
                 let candidate = compare_graphs(k, &graph_a, &graph_b, params.max_regions);
-                (candidate, graph_a, graph_b, clustering.centroids)
-            })
-            .collect();
-        tried.extend(results);
-    }
+                Ok((candidate, graph_a, graph_b, clustering.centroids))
+            };
+            let batch = rayon::current_num_threads().max(1);
+            let mut tried: Vec<Tried> = Vec::new();
+            for (done, ks) in all_k.chunks(batch).enumerate() {
+                cancel.set_fraction((done * batch) as f32 / all_k.len() as f32);
+                let results: Result<Vec<Tried>> = ks.par_iter().map(|&k| try_k(k)).collect();
+                tried.extend(results?);
+            }
+            Ok(tried)
+        },
+    )?;
     let chosen = choose_k(
         &tried.iter().map(|t| t.0.clone()).collect::<Vec<_>>(),
         params.tie_break,

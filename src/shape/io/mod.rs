@@ -134,8 +134,51 @@ pub fn read_xyz(path: &Path) -> Result<RawShape> {
     parse_xyz(&read_bytes(path)?, path)
 }
 
+/// Largest shape file read: 4 GiB, about 20 million vertices of ASCII PLY with faces (some
+/// 200 bytes a vertex), ten times the default `max_vertices`. A larger file is refused
+/// before anything is read.
+pub const MAX_FILE_BYTES: u64 = 4 << 30;
+
+/// The bytes of a regular file of at most [`MAX_FILE_BYTES`]. FIFOs, devices (`/dev/zero`,
+/// also through a symbolic link), sockets and directories are refused before the file is
+/// opened, so reading never blocks or runs unbounded.
 fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read the file: {e}")))
+    use std::io::Read;
+    let cannot = |e: std::io::Error| Error::file(path, format!("cannot read the file: {e}"));
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            "a special file (a FIFO, a device or a socket)"
+        };
+        return Err(Error::file(
+            path,
+            format!("is {what}, not a regular file; shapecorr reads regular files only"),
+        ));
+    }
+    let too_large = |size: u64| {
+        Error::file(
+            path,
+            format!(
+                "the file has {size} bytes, more than the {MAX_FILE_BYTES} bytes (4 GiB) \
+                 shapecorr reads; simplify the shape"
+            ),
+        )
+    };
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)
+        .map_err(cannot)?
+        .take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -152,18 +195,32 @@ fn text_of(bytes: &[u8]) -> Cow<'_, str> {
 /// surrounding white space trimmed and empty lines skipped.
 fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
     text.split('\n').enumerate().filter_map(|(i, line)| {
-        let line = line.split('#').next().unwrap_or_default().trim();
+        let line = line
+            .split('#')
+            .next()
+            .unwrap_or_default()
+            .trim_matches(|c: char| c.is_ascii_whitespace());
         (!line.is_empty()).then_some((i + 1, line))
     })
 }
 
 /// A token for an error message, cut to a readable length.
+/// Characters other than printable ASCII are written as `\u{85}`, so an invisible one
+/// (a Unicode space inside a number) shows.
 fn shown(token: &str) -> String {
     const MAX: usize = 40;
+    let visible = |c: char| {
+        if c.is_ascii_graphic() || c == ' ' {
+            c.to_string()
+        } else {
+            c.escape_unicode().to_string()
+        }
+    };
+    let cut: String = token.chars().take(MAX).map(visible).collect();
     if token.chars().count() <= MAX {
-        token.to_string()
+        cut
     } else {
-        format!("{}...", token.chars().take(MAX).collect::<String>())
+        format!("{cut}...")
     }
 }
 

@@ -61,7 +61,7 @@ fn obj(bytes: &[u8]) -> Result<RawShape, String> {
     let text = text_of(bytes);
     let mut shape = RawShape::default();
     for (line, content) in data_lines(&text) {
-        let mut tokens = content.split_whitespace();
+        let mut tokens = content.split_ascii_whitespace();
         let keyword = tokens.next().unwrap_or_default();
         match keyword {
             "v" => shape.vertices.push(parse_xyz_tokens(tokens, line)?),

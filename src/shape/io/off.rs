@@ -25,7 +25,7 @@ fn off(bytes: &[u8]) -> Result<RawShape, String> {
             "no OFF header: the file holds only comments or blank lines".to_string()
         });
     };
-    let mut tokens = header.split_whitespace();
+    let mut tokens = header.split_ascii_whitespace();
     let keyword = tokens.next().unwrap_or_default();
     check_off_keyword(keyword, first)?;
     let mut counts: Vec<&str> = tokens.collect();
@@ -42,7 +42,7 @@ fn off(bytes: &[u8]) -> Result<RawShape, String> {
         let Some((n, line)) = lines.next() else {
             return Err("truncated header: the vertex and face counts are missing".to_string());
         };
-        counts = line.split_whitespace().collect();
+        counts = line.split_ascii_whitespace().collect();
         counts_line = n;
     }
     let count = |k: usize, what: &str| -> Result<usize, String> {
@@ -69,7 +69,7 @@ fn off(bytes: &[u8]) -> Result<RawShape, String> {
                 "truncated file: expected {n_vertices} vertices, file ends after {found}"
             ));
         };
-        vertices.push(parse_xyz_tokens(content.split_whitespace(), line)?);
+        vertices.push(parse_xyz_tokens(content.split_ascii_whitespace(), line)?);
     }
     let mut polygons = Vec::with_capacity(capped(n_faces, bytes.len(), 8));
     for found in 0..n_faces {
@@ -109,7 +109,7 @@ fn check_off_keyword(keyword: &str, line: usize) -> Result<(), String> {
 
 /// `n i1 .. in [colour ...]`.
 fn off_face(content: &str, line: usize) -> Result<Vec<u32>, String> {
-    let mut tokens = content.split_whitespace();
+    let mut tokens = content.split_ascii_whitespace();
     let first = tokens.next().unwrap_or_default();
     let n = first
         .parse::<usize>()

@@ -131,7 +131,7 @@ fn check_ply_header(header: &Header, header_bytes: &[u8]) -> Result<(), String> 
     let text = String::from_utf8_lossy(header_bytes);
     let declared = |word: &str| {
         text.lines()
-            .filter(|l| l.split_whitespace().next() == Some(word))
+            .filter(|l| l.split_ascii_whitespace().next() == Some(word))
             .count()
     };
     let properties: usize = header.elements.values().map(|e| e.properties.len()).sum();
@@ -311,7 +311,7 @@ impl Body<'_> {
         };
         let text =
             std::str::from_utf8(bytes).map_err(|_| format!("line {line}: not valid text"))?;
-        let mut tokens = text.split_whitespace();
+        let mut tokens = text.split_ascii_whitespace();
         let mut element = E::new();
         for p in def.properties.values() {
             let result = match &p.data_type {

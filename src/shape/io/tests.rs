@@ -249,3 +249,43 @@ fn encode_checks_parameters() {
         })
     ));
 }
+
+/// Issue 19, item 15: only ASCII white space separates numbers. A U+0085 (next line),
+/// U+00A0 (no-break space) or U+2003 (em space) inside or between numbers is an error
+/// naming the file and the line, never two numbers.
+#[test]
+fn unicode_white_space_is_not_a_separator() {
+    for odd in ['\u{85}', '\u{a0}', '\u{2003}'] {
+        let cases: [(&str, String); 5] = [
+            (
+                "a.off",
+                format!("OFF\n3 1 0\n0 0 0\n1 0{odd}5 0\n0 1 0\n3 0 1 2\n"),
+            ),
+            (
+                "a.obj",
+                format!("v 0 0 0\nv 1 0{odd}5 0\nv 0 1 0\nf 1 2 3\n"),
+            ),
+            ("a.xyz", format!("0 0 0\n1 0{odd}5 0\n0 1 0\n")),
+            ("b.xyz", format!("0 0 0\n1{odd}0 0\n0 1 0\n")),
+            (
+                "a.ply",
+                format!(
+                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                     property float z\nend_header\n0 0 0\n1 0{odd}5 0\n0 1 0\n"
+                ),
+            ),
+        ];
+        for (file, text) in cases {
+            let name = Path::new(file);
+            let result = parse_shape(text.as_bytes(), name);
+            let message = match result {
+                Ok(s) => panic!("{file} with {odd:?}: read as {:?}", s.vertices),
+                Err(e) => e.to_string(),
+            };
+            assert!(message.contains(file), "{message}");
+            assert!(message.contains("line"), "{file}: {message}");
+            let escaped = odd.escape_unicode().to_string();
+            assert!(message.contains(&escaped), "{file}: {message}");
+        }
+    }
+}

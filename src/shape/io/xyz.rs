@@ -16,7 +16,7 @@ pub fn parse_xyz(bytes: &[u8], name: &Path) -> Result<RawShape> {
 
 /// The numbers of a point-list line: separated by white space or commas.
 fn split_xyz(line: &str) -> Vec<&str> {
-    line.split(|c: char| c.is_whitespace() || c == ',')
+    line.split(|c: char| c.is_ascii_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
         .collect()
 }

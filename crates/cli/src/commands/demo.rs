@@ -59,8 +59,14 @@ impl DemoArgs {
         let full_b = Eigenbasis::compute(&b, &eigen)?;
         let basis_a = truncated(&full_a, params.eigen.n_eigenpairs);
         let basis_b = truncated(&full_b, params.eigen.n_eigenpairs);
-        let result =
-            Correspondence::from_bases(&a, &basis_a, &b, &basis_b, &params, &mut TerminalProgress);
+        let result = Correspondence::from_bases(
+            &a,
+            &basis_a,
+            &b,
+            &basis_b,
+            &params,
+            &mut TerminalProgress::new(),
+        );
         end_progress_line();
         let result = result?;
         eprintln!();

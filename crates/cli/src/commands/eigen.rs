@@ -36,7 +36,7 @@ impl EigenArgs {
     pub fn run(&self) -> Result<(), Error> {
         let file = &self.file;
         let t0 = Instant::now();
-        let shape = read_shape(file, self.points, self.no_repair, None)?;
+        let shape = read_shape(file, self.points, self.no_repair)?;
         let t_read = t0.elapsed().as_secs_f64();
         let params = EigenParams {
             n_eigenpairs: self.k,
@@ -59,7 +59,7 @@ impl EigenArgs {
         }
         if self.json {
             let value = json!({
-                "file": file,
+                "file": file.to_string_lossy(),
                 "n_vertices": shape.n_vertices(),
                 "k": values.len(),
                 "eigenvalues": values,

@@ -25,7 +25,7 @@ pub struct InfoArgs {
 impl InfoArgs {
     pub fn run(&self) -> Result<(), Error> {
         let file = &self.file;
-        let shape = read_shape(file, self.points, self.no_repair, None)?;
+        let shape = read_shape(file, self.points, self.no_repair)?;
         let laplacian = Laplacian::new(&shape)?;
         let warnings: Vec<String> = shape.warnings().iter().map(|w| w.to_string()).collect();
         let kind = match shape.kind() {
@@ -34,7 +34,7 @@ impl InfoArgs {
         };
         if self.json {
             let value = json!({
-                "file": file,
+                "file": file.to_string_lossy(),
                 "kind": shape.kind(),
                 "n_vertices": shape.n_vertices(),
                 "n_faces": shape.triangles().len(),
@@ -53,8 +53,8 @@ impl InfoArgs {
             println!("kind:        {kind}");
             println!("vertices:    {}", shape.n_vertices());
             println!("faces:       {}", shape.triangles().len());
-            println!("area:        {:.6}", laplacian.input_area);
-            println!("width:       {:.6}", shape.width());
+            println!("area:        {:.6e}", laplacian.input_area);
+            println!("width:       {:.6e}", shape.width());
             println!("pieces:      {}", shape.n_pieces());
             for w in warnings {
                 println!("warning:     {w}");

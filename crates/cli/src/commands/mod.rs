@@ -7,3 +7,15 @@ pub mod info;
 pub mod p2p;
 pub mod regions;
 pub mod synth;
+
+use std::path::Path;
+
+use shapecorr::Error;
+
+/// An error about shape A or B of a pair ([`Error::InShape`]) as one naming its file too.
+pub fn naming_files(e: Error, a: &Path, b: &Path) -> Error {
+    match e {
+        Error::InShape { side, .. } => Error::file(if side == 'A' { a } else { b }, e.to_string()),
+        e => e,
+    }
+}

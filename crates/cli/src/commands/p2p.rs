@@ -6,7 +6,8 @@ use serde_json::json;
 use shapecorr::maps::pointwise::PointwiseCorrespondence;
 use shapecorr::Error;
 
-use crate::input::read_shape;
+use crate::commands::naming_files;
+use crate::input::read_input;
 use crate::options::PointwiseOptions;
 use crate::output::{
     confidence_summary, correspondence_json, create_dir, end_progress_line, options_json,
@@ -34,8 +35,8 @@ pub struct P2pArgs {
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let shape_a = read_shape(&self.a, self.points, self.no_repair, Some("A"))?;
-        let shape_b = read_shape(&self.b, self.points, self.no_repair, Some("B"))?;
+        let shape_a = read_input('A', &self.a, self.points, self.no_repair)?;
+        let shape_b = read_input('B', &self.b, self.points, self.no_repair)?;
         let out = &self.out;
         create_dir(out)?;
         let result = PointwiseCorrespondence::compute(
@@ -43,10 +44,10 @@ impl P2pArgs {
             &shape_b,
             &options.params,
             &pointwise,
-            &mut TerminalProgress,
+            &mut TerminalProgress::new(),
         );
         end_progress_line();
-        let result = result?;
+        let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
         let map = &result.map.p2p_ba;
         write_map(&out.join("map_b_to_a.txt"), map)?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result.regions);

@@ -7,7 +7,8 @@ use serde_json::json;
 use shapecorr::correspondence::{Correspondence, Symmetry};
 use shapecorr::Error;
 
-use crate::input::read_shape;
+use crate::commands::naming_files;
+use crate::input::read_input;
 use crate::options::RegionOptions;
 use crate::output::{
     confidence_summary, correspondence_json, create_dir, end_progress_line, graph_json,
@@ -35,14 +36,18 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape_a = read_shape(&self.a, self.points, self.no_repair, Some("A"))?;
-        let shape_b = read_shape(&self.b, self.points, self.no_repair, Some("B"))?;
+        let shape_a = read_input('A', &self.a, self.points, self.no_repair)?;
+        let shape_b = read_input('B', &self.b, self.points, self.no_repair)?;
         let out = &self.out;
         create_dir(out)?;
-        let result =
-            Correspondence::compute(&shape_a, &shape_b, &options.params, &mut TerminalProgress);
+        let result = Correspondence::compute(
+            &shape_a,
+            &shape_b,
+            &options.params,
+            &mut TerminalProgress::new(),
+        );
         end_progress_line();
-        let result = result?;
+        let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
         value["options"] = options_json(&options, false);
         write_json(&out.join("result.json"), &value)?;
@@ -82,10 +87,10 @@ pub struct SymmetryArgs {
 impl SymmetryArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape = read_shape(&self.a, self.points, self.no_repair, Some("A"))?;
+        let shape = read_input('A', &self.a, self.points, self.no_repair)?;
         let out = &self.out;
         create_dir(out)?;
-        let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress);
+        let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress::new());
         end_progress_line();
         let symmetry = symmetry?;
         let colors = symmetry.vertex_colors();

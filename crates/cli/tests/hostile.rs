@@ -1,0 +1,242 @@
+//! Issue 19 on the command line: odd file names, special files, extreme option values and
+//! bad shapes in a pair end with a clear one-line error (or work), never a panic or a hang.
+
+use std::ffi::OsString;
+use std::os::unix::ffi::OsStringExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn shapecorr<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_shapecorr"))
+        .args(args)
+        .output()
+        .expect("the shapecorr binary runs")
+}
+
+/// Runs shapecorr, killing it after `limit`; `None` when it had to be killed.
+fn shapecorr_within<S: AsRef<std::ffi::OsStr>>(args: &[S], limit: Duration) -> Option<Output> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shapecorr"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while started.elapsed() < limit {
+        if child.try_wait().unwrap().is_some() {
+            return Some(child.wait_with_output().unwrap());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    None
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("shapecorr-hostile-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn synth(path: &Path, pose: &str) {
+    let out = shapecorr(&[
+        "synth",
+        "--kind",
+        "humanoid",
+        "--pose",
+        pose,
+        "--vertices",
+        "800",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Fails with one line on stderr (no panic) that contains every one of `needles`.
+fn assert_clean_failure(out: &Output, needles: &[&str]) {
+    let err = stderr(out);
+    assert!(!out.status.success(), "{err}");
+    assert_ne!(out.status.code(), Some(101), "panicked: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for needle in needles {
+        assert!(err.contains(needle), "`{needle}` not in: {err}");
+    }
+}
+
+#[test]
+fn a_non_utf8_file_name_works_with_json() {
+    let dir = scratch("utf8");
+    let plain = dir.join("a.ply");
+    synth(&plain, "0");
+    let mut odd = dir.clone().into_os_string().into_vec();
+    odd.extend_from_slice(b"/bad\xffname.ply");
+    let odd = PathBuf::from(OsString::from_vec(odd));
+    std::fs::rename(&plain, &odd).unwrap();
+    for args in [
+        vec![
+            OsString::from("info"),
+            OsString::from("--json"),
+            odd.clone().into(),
+        ],
+        vec![
+            "eigen".into(),
+            "--json".into(),
+            "--k".into(),
+            "5".into(),
+            odd.clone().into(),
+        ],
+    ] {
+        let out = shapecorr(&args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        let value: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let file = value["file"].as_str().unwrap();
+        assert!(file.ends_with("bad\u{fffd}name.ply"), "{file}");
+    }
+}
+
+#[test]
+fn a_fifo_or_a_device_is_refused_at_once() {
+    let dir = scratch("special");
+    let fifo = dir.join("f.ply");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let zero = dir.join("z.ply");
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    for path in [&fifo, &zero, &dir.join("folder.ply")] {
+        if !path.exists() {
+            std::fs::create_dir(path).unwrap();
+        }
+        let started = Instant::now();
+        let out = shapecorr_within(
+            &["info".as_ref(), path.as_os_str()],
+            Duration::from_secs(20),
+        )
+        .unwrap_or_else(|| panic!("{} hung", path.display()));
+        assert!(started.elapsed() < Duration::from_secs(5));
+        assert_clean_failure(&out, &["not a regular file", path.to_str().unwrap()]);
+    }
+}
+
+#[test]
+fn extreme_option_values_are_refused_naming_the_option_and_its_range() {
+    let dir = scratch("options");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth(&a, "0");
+    synth(&b, "3");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let out_dir = dir.join("out");
+    let out_dir = out_dir.to_str().unwrap();
+    for (flag, value, needles) in [
+        ("--k-min", "-1", ["k_min", "[2, 100]"]),
+        ("--hks-times", "100000000", ["hks_times", "[1, 100]"]),
+        (
+            "--histogram-bins",
+            "1000000000000",
+            ["histogram_bins", "[1, 1000]"],
+        ),
+        ("--threads", "1000000000000", ["threads", "[0, 1024]"]),
+        ("--sigma", "1e300", ["sigma", "[0.001, 100]"]),
+        (
+            "--p2p-eigenpairs",
+            "1000000",
+            ["p2p_eigenpairs", "[2, 1000]"],
+        ),
+    ] {
+        let out = shapecorr(&["p2p", a, b, "--out", out_dir, flag, value]);
+        assert_clean_failure(&out, &needles);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "a usage error: {}",
+            stderr(&out)
+        );
+    }
+    // eigen's own --threads: clamped to the cores, it works at once.
+    let out = shapecorr_within(
+        &["eigen", a, "--k", "5", "--threads", "1000000000000"],
+        Duration::from_secs(60),
+    )
+    .expect("eigen --threads 1e12 hung");
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn a_bad_shape_in_a_pair_names_its_side_and_file() {
+    let dir = scratch("pair");
+    let good = dir.join("good.ply");
+    synth(&good, "0");
+    let bad = dir.join("bad.off");
+    let mut text = String::from("OFF\n40 1 0\n");
+    for i in 0..40 {
+        text.push_str(&format!("{} {} {}\n", i, i * i, 1));
+    }
+    text.push_str("3 0 1 99\n");
+    std::fs::write(&bad, text).unwrap();
+    let out_dir = dir.join("out");
+    for command in ["match", "p2p"] {
+        let out = shapecorr(&[
+            command,
+            good.to_str().unwrap(),
+            bad.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert_clean_failure(&out, &["shape B", bad.to_str().unwrap(), "vertex 99"]);
+        let out = shapecorr(&[
+            command,
+            bad.to_str().unwrap(),
+            good.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert_clean_failure(&out, &["shape A", bad.to_str().unwrap()]);
+    }
+}
+
+/// Issue 19, item 9: stderr that is not a terminal gets progress lines (at most one a
+/// second), `--quiet` none.
+#[test]
+fn progress_is_written_as_lines_when_stderr_is_not_a_terminal() {
+    let dir = scratch("progress");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth(&a, "0");
+    synth(&b, "3");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let out_dir = dir.join("out");
+    // 400 k-means restarts: several seconds of segmentation.
+    let args = [
+        "match",
+        a,
+        b,
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--kmeans-restarts",
+        "400",
+    ];
+    let out = shapecorr(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let lines: Vec<String> = stderr(&out)
+        .lines()
+        .filter(|l| l.starts_with("shapecorr: progress: "))
+        .map(str::to_string)
+        .collect();
+    assert!(!lines.is_empty(), "no progress lines: {}", stderr(&out));
+    assert!(
+        lines.iter().any(|l| l.contains("Segmentation")),
+        "{lines:?}"
+    );
+    let quiet = shapecorr(&[&args[..], &["--quiet"]].concat());
+    assert!(quiet.status.success());
+    assert!(!stderr(&quiet).contains("progress"), "{}", stderr(&quiet));
+}
