@@ -106,14 +106,17 @@ pub(crate) fn polled<T: Send>(
             caller.unpark();
             result
         });
+        let mut cancelled = false;
         while !worker.is_finished() {
             std::thread::park_timeout(POLL_INTERVAL);
-            if worker.is_finished() {
-                break;
+            // Nothing is reported after a cancel, while the work winds down.
+            if worker.is_finished() || cancelled {
+                continue;
             }
             let done = f32::from_bits(cancel.fraction.load(std::sync::atomic::Ordering::Relaxed));
             let fraction = start + (end - start) * done.clamp(0.0, 1.0);
             if !progress.report(stage, fraction.clamp(0.0, 1.0)) {
+                cancelled = true;
                 cancel
                     .stop
                     .store(true, std::sync::atomic::Ordering::Relaxed);

@@ -508,10 +508,12 @@ impl Verdict {
     }
 
     /// Settles a close call with the full-resolution consistencies of the chosen hypothesis
-    /// and its competitor `rival`: the more consistent is chosen (the chosen one keeps ties),
-    /// `distance_to_chosen` follows it (`sample_maps`, on A's vertices `va` of area `area_a`),
-    /// and the confidence's margin factor becomes the relative consistency margin against
-    /// [`FULL_MARGIN_SCALE`]. Returns whether the choice changed.
+    /// and its competitor `rival`: the more consistent is chosen (the chosen one keeps ties).
+    /// When that changes the choice, `distance_to_chosen` follows it (`sample_maps`, on A's
+    /// vertices `va` of area `area_a`) and the confidence becomes the new choice's
+    /// consistency factor times the relative full-resolution margin against
+    /// [`FULL_MARGIN_SCALE`], at most the confidence before (a close call stays as doubtful
+    /// as it was). Returns whether the choice changed.
     pub fn settle(
         &mut self,
         rival: usize,
@@ -519,25 +521,20 @@ impl Verdict {
         sample_maps: &[&[u32]],
         (va, area_a): (&[[f64; 3]], f64),
     ) -> bool {
-        let changed = rival_full > chosen_full;
-        if changed {
-            self.chosen = rival;
-            let scale = 1.0 / area_a.sqrt();
-            for (h, score) in self.scores.iter_mut().enumerate() {
-                score.distance_to_chosen =
-                    mean_image_distance(sample_maps[h], sample_maps[rival], va) * scale;
-            }
+        if rival_full <= chosen_full {
+            return false;
         }
-        let (winner, loser) = if changed {
-            (rival_full, chosen_full)
-        } else {
-            (chosen_full, rival_full)
-        };
-        let relative = (winner - loser) / winner.max(1e-12);
+        self.chosen = rival;
+        let scale = 1.0 / area_a.sqrt();
+        for (h, score) in self.scores.iter_mut().enumerate() {
+            score.distance_to_chosen =
+                mean_image_distance(sample_maps[h], sample_maps[rival], va) * scale;
+        }
+        let relative = (rival_full - chosen_full) / rival_full.max(1e-12);
         let consistency = (-self.chosen().energy.cost() / COST_SCALE).exp();
-        let margin = 1.0 - (-relative.max(0.0) / FULL_MARGIN_SCALE).exp();
-        self.confidence = (consistency * margin).clamp(0.0, 1.0);
-        changed
+        let margin = 1.0 - (-relative / FULL_MARGIN_SCALE).exp();
+        self.confidence = (consistency * margin).clamp(0.0, self.confidence);
+        true
     }
 }
 
