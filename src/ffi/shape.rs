@@ -220,9 +220,9 @@ pub unsafe extern "C" fn sc_shape_read_repaired(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_shape, "out_shape")?;
-        let path = input_str(path, "path")?;
+        let path = input_path(path, "path")?;
         let shape = Shape::read_with(
-            std::path::Path::new(path),
+            &path,
             ReadAs::point_cloud_when(as_point_cloud),
             &repairs_of(repairs)?,
         )?;
