@@ -82,15 +82,19 @@ pub fn effective_threads(threads: usize) -> usize {
     }
 }
 
-/// Fixes faer's global parallelism (its matrix products and dense decompositions) to the
-/// machine's cores, once per process. faer splits work by its `Par`'s thread count and the
-/// split changes the rounding; its default, `Par::rayon(0)`, takes the size of the current
-/// rayon pool, so results differed in the last digits between RAYON_NUM_THREADS=1 and 2
-/// (issue 19). Fixed, they are bit-identical for any pool size on one machine.
+/// Fixes faer's global parallelism (its matrix products and dense decompositions) to
+/// [`FAER_SPLIT`] tasks, once per process. faer splits work by its `Par`'s thread count and
+/// the split changes the rounding; its default, `Par::rayon(0)`, takes the size of the
+/// current rayon pool, so results differed in the last digits between RAYON_NUM_THREADS=1
+/// and 2 (issue 19). A constant split (not the machine's cores) keeps them bit-identical for
+/// any pool size on any machine; the tasks run on however many threads the pool has.
 pub fn fix_faer_parallelism() {
     static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| faer::set_global_parallelism(Par::rayon(effective_threads(0))));
+    ONCE.call_once(|| faer::set_global_parallelism(Par::rayon(FAER_SPLIT)));
 }
+
+/// The number of tasks faer's parallel kernels split into ([`fix_faer_parallelism`]).
+pub const FAER_SPLIT: usize = 8;
 
 /// Most eigenpairs computed (the range of the options `eigenpairs` and `p2p_eigenpairs`):
 /// an n x 1000 basis of a 2M-vertex shape is 16 GB.
