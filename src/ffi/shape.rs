@@ -256,12 +256,7 @@ pub unsafe extern "C" fn sc_shape_read(
     as_point_cloud: bool,
     out_shape: *mut *mut ScShape,
 ) -> ScStatus {
-    boundary(|| {
-        check_out(out_shape, "out_shape")?;
-        let path = input_path(path, "path")?;
-        let shape = Shape::read(&path, ReadAs::point_cloud_when(as_point_cloud))?;
-        give_handle(out_shape, ScShape { shape })
-    })
+    sc_shape_read_repaired(path, as_point_cloud, SC_REPAIR_ALL, out_shape)
 }
 
 /// A path from C: any bytes on Unix (file names need not be UTF-8), UTF-8 elsewhere.

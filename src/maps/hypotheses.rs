@@ -478,20 +478,9 @@ pub const FULL_MARGIN_SCALE: f64 = 0.05;
 /// reaches times the fraction of B's oriented faces whose image keeps its orientation.
 pub fn full_consistency(a: &Shape, (faces_a, faces_b): &OrientedFaces, p2p_ba: &[u32]) -> f64 {
     let normals_a = vertex_normals(a.vertices(), faces_a);
-    let (mut kept, mut total) = (0usize, 0usize);
-    for t in faces_b {
-        let turn = signed_turn(
-            a.vertices(),
-            t.map(|v| p2p_ba[v as usize] as usize),
-            &normals_a,
-        );
-        if turn != 0.0 {
-            total += 1;
-            kept += usize::from(turn > 0.0);
-        }
-    }
+    let kept = orientation_kept((a.vertices(), &normals_a), faces_b, p2p_ba).unwrap_or(0.0);
     let reached = covered_vertices(p2p_ba, a.n_vertices()) as f64;
-    reached / a.active_vertices().len().max(1) as f64 * kept as f64 / total.max(1) as f64
+    reached / a.active_vertices().len().max(1) as f64 * kept
 }
 
 impl Verdict {
@@ -709,18 +698,22 @@ fn sample_orientation(
 /// not orientable, or no triangle maps to a proper triangle.
 pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
     let normals_a = vertex_normals(a.vertices(), &a.oriented_triangles()?);
+    orientation_kept((a.vertices(), &normals_a), &b.oriented_triangles()?, p2p_ba)
+}
+
+/// Fraction of `faces_b` whose image under `p2p_ba` keeps its orientation against A's vertex
+/// normals; `None` when no face maps to a proper triangle.
+fn orientation_kept(
+    (va, normals_a): (&[[f64; 3]], &[[f64; 3]]),
+    faces_b: &[[u32; 3]],
+    p2p_ba: &[u32],
+) -> Option<f64> {
     let (mut kept, mut total) = (0usize, 0usize);
-    for t in &b.oriented_triangles()? {
-        let turn = signed_turn(
-            a.vertices(),
-            t.map(|v| p2p_ba[v as usize] as usize),
-            &normals_a,
-        );
+    for t in faces_b {
+        let turn = signed_turn(va, t.map(|v| p2p_ba[v as usize] as usize), normals_a);
         if turn != 0.0 {
             total += 1;
-            if turn > 0.0 {
-                kept += 1;
-            }
+            kept += usize::from(turn > 0.0);
         }
     }
     (total > 0).then(|| kept as f64 / total as f64)

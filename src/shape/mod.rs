@@ -343,12 +343,7 @@ impl Shape {
                 shape.check_edges();
             }
             ShapeKind::PointCloud => {
-                let active_points: Vec<[f64; 3]> = shape
-                    .active
-                    .iter()
-                    .map(|&v| shape.vertices[v as usize])
-                    .collect();
-                let extent = bounding_box_diagonal(&active_points);
+                let extent = bounding_box_diagonal(&shape.active_points());
                 if !(extent > 0.0) {
                     return Err(Error::ZeroArea {
                         detail: format!("all {} points coincide", shape.vertices.len()),
@@ -416,18 +411,11 @@ impl Shape {
             for t in &mut triangles {
                 *t = t.map(|v| welded_to[v as usize]);
             }
-            let before = triangles.len();
-            triangles.retain(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
-            let mut seen = std::collections::HashSet::with_capacity(triangles.len());
-            triangles.retain(|t| {
-                let mut key = *t;
-                key.sort_unstable();
-                seen.insert(key)
-            });
+            let (degenerate, duplicate) = drop_improper_faces(&mut triangles);
             warnings.push(Warning::VerticesWelded { count: welded });
-            if triangles.len() < before {
+            if degenerate + duplicate > 0 {
                 warnings.push(Warning::DegenerateFacesDropped {
-                    count: before - triangles.len(),
+                    count: degenerate + duplicate,
                 });
             }
         }
@@ -579,12 +567,15 @@ impl Shape {
 
     /// Length of the bounding-box diagonal of the active vertices, the "width" of the shape.
     pub fn width(&self) -> f64 {
-        let active: Vec<[f64; 3]> = self
-            .active
+        bounding_box_diagonal(&self.active_points())
+    }
+
+    /// Positions of the active vertices, in [`Shape::active_vertices`] order.
+    fn active_points(&self) -> Vec<[f64; 3]> {
+        self.active
             .iter()
             .map(|&v| self.vertices[v as usize])
-            .collect();
-        bounding_box_diagonal(&active)
+            .collect()
     }
 
     /// Undirected edges between active vertices, each once as (low, high), sorted: mesh edges,
@@ -598,13 +589,8 @@ impl Shape {
                 .map(|(a, b)| (a.min(b), a.max(b)))
                 .collect(),
             ShapeKind::PointCloud => {
-                let points: Vec<[f64; 3]> = self
-                    .active
-                    .iter()
-                    .map(|&v| self.vertices[v as usize])
-                    .collect();
                 let active = &self.active;
-                symmetric_knn_graph(&points, POINT_CLOUD_GRAPH_K)
+                symmetric_knn_graph(&self.active_points(), POINT_CLOUD_GRAPH_K)
                     .into_iter()
                     .enumerate()
                     .flat_map(|(i, list)| {
@@ -816,13 +802,22 @@ fn clean_faces(
     if n_polygons > 0 {
         warnings.push(Warning::PolygonsTriangulated { count: n_polygons });
     }
+    let (degenerate, duplicate) = drop_improper_faces(&mut triangles);
+    if degenerate > 0 {
+        warnings.push(Warning::DegenerateFacesDropped { count: degenerate });
+    }
+    if duplicate > 0 {
+        warnings.push(Warning::DuplicateFacesDropped { count: duplicate });
+    }
+    Ok(triangles)
+}
+
+/// Drops the faces with a repeated corner, then those with the same corners as an earlier
+/// face; returns how many of each.
+fn drop_improper_faces(triangles: &mut Vec<[u32; 3]>) -> (usize, usize) {
     let before = triangles.len();
     triangles.retain(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
-    if triangles.len() < before {
-        warnings.push(Warning::DegenerateFacesDropped {
-            count: before - triangles.len(),
-        });
-    }
+    let degenerate = before - triangles.len();
     let mut seen = std::collections::HashSet::with_capacity(triangles.len());
     let before = triangles.len();
     triangles.retain(|t| {
@@ -830,12 +825,7 @@ fn clean_faces(
         key.sort_unstable();
         seen.insert(key)
     });
-    if triangles.len() < before {
-        warnings.push(Warning::DuplicateFacesDropped {
-            count: before - triangles.len(),
-        });
-    }
-    Ok(triangles)
+    (degenerate, before - triangles.len())
 }
 
 /// Splits a polygon into triangles: a quad along its shorter diagonal, larger polygons as

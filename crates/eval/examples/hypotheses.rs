@@ -128,36 +128,9 @@ fn one_pair(
         })
         .collect();
     let mut maps = maps;
-    let misfit = |d_a: &faer::Mat<f64>, d_b: &faer::Mat<f64>, p2p: &[u32]| -> f64 {
-        // Columns scaled by their mean on each shape, then mean relative L1 misfit.
-        let mean = |d: &faer::Mat<f64>, c: usize| {
-            (0..d.nrows()).map(|v| d[(v, c)].abs()).sum::<f64>() / d.nrows() as f64
-        };
-        let (mut num, mut den) = (0.0, 0.0);
-        for c in 0..d_a.ncols() {
-            let (ma, mb) = (mean(d_a, c).max(1e-300), mean(d_b, c).max(1e-300));
-            for (v, &x) in p2p.iter().enumerate() {
-                num += (d_b[(v, c)] / mb - d_a[(x as usize, c)] / ma).abs();
-                den += (d_b[(v, c)] / mb).abs();
-            }
-        }
-        num / den.max(1e-300)
-    };
-    let wks_p = shapecorr::spectral::descriptors::WksParams::default();
-    let (wa, wb) = (
-        shapecorr::spectral::descriptors::wks(basis_a, &wks_p)?,
-        shapecorr::spectral::descriptors::wks(basis_b, &wks_p)?,
-    );
-    let hks_p = shapecorr::spectral::descriptors::HksParams {
-        t_min: 0.002,
-        t_max: 0.05,
-        ..Default::default()
-    };
-    let (ha, hb) = (
-        shapecorr::spectral::descriptors::hks(basis_a, &hks_p)?,
-        shapecorr::spectral::descriptors::hks(basis_b, &hks_p)?,
-    );
-    let extra: Vec<(f64, f64, Option<f64>, f64)> = maps
+    // Full-resolution orientation kept and coverage of A's vertices (the close call's
+    // `full_consistency` is their product).
+    let extra: Vec<(Option<f64>, f64)> = maps
         .iter()
         .map(|(_, p2p, _)| {
             let mut hit = vec![false; a.n_vertices()];
@@ -166,8 +139,6 @@ fn one_pair(
             }
             let covered = hit.iter().filter(|&&h| h).count() as f64 / a.n_vertices() as f64;
             (
-                misfit(&wa, &wb, p2p),
-                misfit(&ha, &hb, p2p),
                 shapecorr::maps::hypotheses::orientation_score(a, b, p2p),
                 covered,
             )
@@ -180,7 +151,7 @@ fn one_pair(
     for (i, (h, s)) in verdict.scores.iter().zip(&scores).enumerate() {
         let e = &h.energy;
         println!(
-            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"wks_misfit\":{:.5},\"hks_misfit\":{:.5},\"orient_full\":{:.4},\"cover_full\":{:.4},\"seconds\":{seconds:.3}}}",
+            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"orient_full\":{:.4},\"cover_full\":{:.4},\"seconds\":{seconds:.3}}}",
             pair.source,
             pair.target,
             h.kind.name(),
@@ -194,10 +165,8 @@ fn one_pair(
             s.best_mean(),
             verdict.confidence,
             h.distance_to_chosen,
-            extra[i].0,
+            extra[i].0.unwrap_or(f64::NAN),
             extra[i].1,
-            extra[i].2.unwrap_or(f64::NAN),
-            extra[i].3,
         );
         summary.push_str(&format!(
             " {}{}={:.3}/{:.4}",
