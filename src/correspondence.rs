@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use crate::budget::{regions_job, Budget, Job};
 use crate::colors::{palette, region_colors, UNMATCHED_COLOR};
 use crate::geodesic::region_distance_matrix;
 use crate::maps::hypotheses::Verdict;
@@ -53,6 +54,9 @@ pub struct Params {
     /// eigenbasis ([`crate::maps::hypotheses`]), and give the answer a confidence. Measured
     /// in docs/decisions.md (issue 18).
     pub verify_hypotheses: bool,
+    /// The job's memory ceiling and time limit, checked from an estimate before any work
+    /// and the time limit enforced while it runs ([`crate::budget`]).
+    pub budget: Budget,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -77,6 +81,7 @@ impl Default for Params {
             skip_one_to_one: false,
             fallback: Some(HksFallback::default()),
             verify_hypotheses: true,
+            budget: Budget::default(),
             non_exhaustive: crate::NonExhaustive(()),
         }
     }
@@ -163,6 +168,26 @@ impl Correspondence {
         progress: &mut dyn Progress,
     ) -> Result<Correspondence> {
         params.validate()?;
+        params.budget.check(&Correspondence::job(a, b, params))?;
+        params.budget.run(progress, |progress| {
+            Correspondence::compute_within(a, b, params, progress)
+        })
+    }
+
+    /// What [`Correspondence::compute`] will do on these shapes, for [`Budget::check`].
+    pub fn job(a: &Shape, b: &Shape, params: &Params) -> Job {
+        let verify = params.verify_hypotheses && !params.skip_one_to_one;
+        let sizes = [a, b].map(|s| s.active_vertices().len());
+        regions_job(sizes, &params.eigen, verify)
+    }
+
+    /// [`Correspondence::compute`] once the budget has accepted the job.
+    fn compute_within(
+        a: &Shape,
+        b: &Shape,
+        params: &Params,
+        progress: &mut dyn Progress,
+    ) -> Result<Correspondence> {
         let started = Instant::now();
         let basis_a = Eigenbasis::compute_with_progress(a, &params.eigen, progress)
             .map_err(|e| e.in_shape('A'))?;
@@ -251,7 +276,8 @@ impl Correspondence {
             verdict: None,
         };
         if params.verify_hypotheses && !params.skip_one_to_one {
-            crate::maps::pointwise::verify_regions((a, basis_a), (b, basis_b), &mut result)?;
+            let (a, b) = ((a, basis_a), (b, basis_b));
+            crate::maps::pointwise::verify_regions(a, b, &mut result, progress)?;
         }
         result.timings.one_to_one = t.elapsed().as_secs_f64();
         check(progress, Stage::SymmetryBreaking, 1.0)?;
@@ -444,8 +470,14 @@ impl Symmetry {
     /// Self-symmetry groups of a shape.
     pub fn detect(shape: &Shape, params: &Params, progress: &mut dyn Progress) -> Result<Symmetry> {
         params.validate()?;
-        let basis = Eigenbasis::compute_with_progress(shape, &params.eigen, progress)?;
-        Symmetry::from_basis(shape, &basis, params, progress)
+        let n = shape.active_vertices().len();
+        params
+            .budget
+            .check(&regions_job([n, n], &params.eigen, false))?;
+        params.budget.run(progress, |progress| {
+            let basis = Eigenbasis::compute_with_progress(shape, &params.eigen, progress)?;
+            Symmetry::from_basis(shape, &basis, params, progress)
+        })
     }
 
     /// As [`Symmetry::detect`] with the eigenbasis given.

@@ -18,7 +18,8 @@
 //! | front ends | [`options`] (the one table of named options), [`ffi`] (the C API), [`colors`] |
 //! | test figures with exact ground truth | [`synth`] |
 //!
-//! [`progress`] carries progress reports and cancellation; [`Error`] is the one error type.
+//! [`progress`] carries progress reports and cancellation, [`budget`] the memory ceiling
+//! and time limit of a job; [`Error`] is the one error type.
 //! The benchmark harness is the workspace crate `shapecorr-eval` (`crates/eval`), the
 //! command line `shapecorr-cli` (`crates/cli`).
 //!
@@ -46,6 +47,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![warn(missing_docs)]
 
+pub mod budget;
 pub mod colors;
 pub mod correspondence;
 pub mod error;

@@ -355,6 +355,18 @@ pub const OPTIONS: &[OptionInfo] = &[
         "largest shape accepted, in vertices; a larger one is refused before any work",
     )
     .range(32.0, 100_000_000.0),
+    info(
+        "memory_limit_mib",
+        Int,
+        "memory ceiling of a job in MiB (0: the memory available); a job estimated above it is refused before any work",
+    )
+    .range(0.0, 16_777_216.0),
+    info(
+        "time_limit_s",
+        Float,
+        "time limit of a job in seconds (0: none); refused at once when estimated above it, stopped when it runs past it",
+    )
+    .range(0.0, 1e7),
 ];
 
 /// The option called `name`.
@@ -551,6 +563,7 @@ impl Params {
                     "exhaustive_limit" => self.symmetry.exhaustive_limit = v,
                     "symmetry_restarts" => self.symmetry.restarts = v,
                     "max_vertices" => self.eigen.max_vertices = v,
+                    "memory_limit_mib" => self.budget.memory_limit_mib = v as u64,
                     other => unreachable!("integer option {other} has no field"),
                 }
             }
@@ -562,6 +575,7 @@ impl Params {
                     "hks_t_max" => self.hks.t_max = v,
                     "sigma" => self.matching.sigma = v,
                     "gap_ratio" => self.matching.gap_ratio = v,
+                    "time_limit_s" => self.budget.time_limit_s = v,
                     other => unreachable!("float option {other} has no field"),
                 }
             }
@@ -606,6 +620,8 @@ impl Params {
             "hks_fallback" => OptionValue::Bool(self.fallback.is_some()),
             "verify_hypotheses" => OptionValue::Bool(self.verify_hypotheses),
             "max_vertices" => int(self.eigen.max_vertices),
+            "memory_limit_mib" => int(self.budget.memory_limit_mib as usize),
+            "time_limit_s" => OptionValue::Float(self.budget.time_limit_s),
             other => unreachable!("option {other} has no field"),
         })
     }
@@ -1051,7 +1067,7 @@ mod tests {
     #[test]
     fn orientation_is_the_pointwise_params_switch() {
         let last = OPTIONS.last().unwrap();
-        assert_eq!((last.name, last.option_type), ("max_vertices", Int));
+        assert_eq!((last.name, last.option_type), ("time_limit_s", Float));
         assert!(Options::default().pointwise().hypotheses);
         let mut options = Options::default();
         assert_eq!(

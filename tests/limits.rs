@@ -1,6 +1,7 @@
 //! Never kill or hang the host (issue 19): every option has a range checked before any
 //! work, a huge but accepted value is cancellable within a fraction of a second, and a
-//! shape above `max_vertices` is refused at once.
+//! shape above `max_vertices` is refused at once, as is a job over its memory ceiling or
+//! time limit.
 
 use std::time::{Duration, Instant};
 
@@ -254,6 +255,15 @@ fn a_shape_scaled_by_1e_minus_100_gives_the_same_answer() {
             .unwrap();
     assert_eq!(with_plain.graph_a.labels, with_small.graph_a.labels);
     assert_eq!(with_plain.matches, with_small.matches);
+    // The orientation test of the map's verification works at that scale too (its normals
+    // underflowed to 0 and the confidence with them).
+    assert_eq!(with_plain.matches_one_to_one, with_small.matches_one_to_one);
+    let (c_plain, c_small) = (with_plain.confidence(), with_small.confidence());
+    assert!(c_plain.unwrap() > 0.0, "{c_plain:?}");
+    assert!(
+        (c_plain.unwrap() - c_small.unwrap()).abs() < 1e-6,
+        "{c_plain:?} vs {c_small:?}"
+    );
 }
 
 /// The memory check before the eigensolve: 1000 eigenpairs of a 2M-vertex shape need
@@ -307,4 +317,111 @@ fn a_job_started_from_the_only_global_pool_worker_finishes() {
     child.kill().unwrap();
     child.wait().unwrap();
     panic!("the job deadlocked with one global thread");
+}
+
+/// Issue 19, item 4: the pointwise map (its functional maps, ZoomOut, the hypotheses'
+/// verification and the full-resolution conversions) honours a cancel inside itself. With
+/// 300 eigenpairs, ZoomOut to 300 and a heavy commutativity term it runs for seconds; it
+/// stopped 0.9 s after a cancel when it checked only between stages.
+#[test]
+fn the_pointwise_map_is_cancelled_within_a_fraction_of_a_second() {
+    let a = humanoid(0, 3000);
+    let b = humanoid(3, 3000);
+    let mut options = Options::default();
+    for (name, value) in [
+        ("p2p_eigenpairs", OptionValue::Int(300)),
+        ("p2p_zoomout_end", OptionValue::Int(300)),
+        ("p2p_zoomout_step", OptionValue::Int(1)),
+        ("p2p_descriptor_commutativity", OptionValue::Float(1e3)),
+    ] {
+        options.set_option(name, value).unwrap();
+    }
+    for after_ms in [100, 400, 1000] {
+        let mut cancel = CancelAfter::new(Duration::from_millis(after_ms));
+        let mut progress =
+            |stage, fraction| stage != Stage::PointwiseMap || cancel.report(stage, fraction);
+        let result = PointwiseCorrespondence::compute(
+            &a,
+            &b,
+            &options.params,
+            options.pointwise(),
+            &mut progress,
+        );
+        let latency = cancel.latency();
+        println!("cancel {after_ms} ms into the map: latency {latency:.3} s");
+        assert!(matches!(result, Err(Error::Cancelled)), "{result:?}");
+        assert!(latency < 0.5, "stopped {latency:.2} s after the cancel");
+    }
+}
+
+/// Issue 19, "done when": a 2M-vertex `match` either finishes within the budget or is
+/// refused at once with the reason. With the default budget it is refused before any work
+/// (its vertex maps alone are about 4e14 products), naming the limit and what to do.
+#[test]
+fn a_two_million_vertex_pair_is_refused_at_once_by_the_default_budget() {
+    // A 1415 x 1415 grid of points: 2,002,225 vertices.
+    let side = 1415;
+    let points: Vec<[f64; 3]> = (0..side * side)
+        .map(|i| [(i % side) as f64, (i / side) as f64, 0.0])
+        .collect();
+    let cloud = Shape::point_cloud_with(points, &shapecorr::Repairs::none()).unwrap();
+    // By default the memory ceiling is what the machine has (under 100 GB here) and the
+    // time limit half an hour; with the largest ceiling, the time limit refuses it.
+    for (memory_limit_mib, refused_by) in [(0, None), (16_777_216, Some("time_limit_s"))] {
+        let mut options = Options::default();
+        options
+            .set_option("memory_limit_mib", OptionValue::Int(memory_limit_mib))
+            .unwrap();
+        let started = Instant::now();
+        let result = shapecorr::Correspondence::compute(
+            &cloud,
+            &cloud,
+            &options.params,
+            &mut shapecorr::NoProgress,
+        );
+        let seconds = started.elapsed().as_secs_f64();
+        let err = result.unwrap_err();
+        println!("memory_limit_mib {memory_limit_mib}: {seconds:.3} s: {err}");
+        assert!(seconds < 1.0, "took {seconds:.2} s to refuse");
+        let Error::InvalidParameter { name, .. } = &err else {
+            panic!("{err}")
+        };
+        assert!(
+            [Some(*name), None].contains(&refused_by)
+                && ["time_limit_s", "memory_limit_mib"].contains(name),
+            "{err}"
+        );
+        assert!(err.to_string().contains("raise"), "{err}");
+    }
+}
+
+/// The time limit is also enforced while a job runs: a job whose estimate fits but which
+/// runs long (1000 k-means restarts) stops at the limit with the error naming it.
+#[test]
+fn a_job_that_runs_past_its_time_limit_stops_there() {
+    let a = humanoid(0, 3000);
+    let b = humanoid(3, 3000);
+    let mut options = Options::default();
+    options
+        .set_option("kmeans_restarts", OptionValue::Int(1000))
+        .unwrap();
+    options
+        .set_option("time_limit_s", OptionValue::Float(1.0))
+        .unwrap();
+    let started = Instant::now();
+    let result =
+        shapecorr::Correspondence::compute(&a, &b, &options.params, &mut shapecorr::NoProgress);
+    let seconds = started.elapsed().as_secs_f64();
+    println!("stopped after {seconds:.2} s: {result:?}");
+    assert!(
+        matches!(
+            result,
+            Err(Error::InvalidParameter {
+                name: "time_limit_s",
+                ..
+            })
+        ),
+        "{result:?}"
+    );
+    assert!(seconds < 2.5, "stopped after {seconds:.2} s");
 }

@@ -29,6 +29,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use crate::progress::Cancel;
 use crate::{Error, Result};
 
 /// Query rows per block of the dense nearest-neighbour search: the block's distance matrix
@@ -223,6 +224,21 @@ pub fn solve_fmap_commuting(
     laplacian_weight: f64,
     terms: &[Commutativity<'_>],
 ) -> Result<Mat<f64>> {
+    let cancel = Cancel::default();
+    let problem = (values_a, values_b, laplacian_weight);
+    solve_fmap_commuting_cancellable(coef_a, coef_b, problem, terms, &cancel)
+}
+
+/// As [`solve_fmap_commuting`], stopping with [`Error::Cancelled`] between
+/// conjugate-gradient iterations once `cancel` is set (up to [`CG_MAX_ITERATIONS`] of
+/// them with a heavy commutativity weight).
+pub(crate) fn solve_fmap_commuting_cancellable(
+    coef_a: MatRef<'_, f64>,
+    coef_b: MatRef<'_, f64>,
+    (values_a, values_b, laplacian_weight): (&[f64], &[f64], f64),
+    terms: &[Commutativity<'_>],
+    cancel: &Cancel,
+) -> Result<Mat<f64>> {
     let (k_a, k_b) = (coef_a.nrows(), coef_b.nrows());
     let fits = |ops: &[Mat<f64>], k: usize| ops.iter().all(|d| d.nrows() == k && d.ncols() == k);
     for term in terms {
@@ -344,6 +360,7 @@ pub fn solve_fmap_commuting(
         if dot(&r, &r).sqrt() <= CG_TOLERANCE * rhs_norm {
             break;
         }
+        cancel.check()?;
         let hp = apply(&p);
         let alpha = rz / dot(&p, &hp);
         x += alpha * &p;
@@ -449,6 +466,17 @@ impl RowSystems {
 /// precision (three times the speed of double here), then the best `RERANK` = 4 candidates
 /// re-ranked by their exact distance. Deterministic on any thread count.
 pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32> {
+    nearest_rows_cancellable(target, query, &Cancel::default()).expect("never cancelled")
+}
+
+/// As [`nearest_rows`], stopping with [`Error::Cancelled`] between blocks of
+/// [`NN_BLOCK`] queries once `cancel` is set (a block of a 50K-vertex target in 100
+/// dimensions takes a few hundredths of a second).
+pub(crate) fn nearest_rows_cancellable(
+    target: MatRef<'_, f64>,
+    query: MatRef<'_, f64>,
+    cancel: &Cancel,
+) -> Result<Vec<u32>> {
     assert_eq!(
         target.ncols(),
         query.ncols(),
@@ -477,12 +505,17 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
         })
         .collect();
     let starts: Vec<usize> = (0..query.nrows()).step_by(NN_BLOCK).collect();
+    // One distance block per worker, reused: a fresh n x NN_BLOCK block per query block
+    // made the allocator keep up to 300 MiB more at 20K vertices (docs/decisions.md,
+    // "Budget").
+    let new_block = || Mat::<f32>::zeros(n, NN_BLOCK.min(query.nrows()));
     let blocks: Vec<Vec<u32>> = starts
         .par_iter()
-        .map(|&start| {
+        .map_init(new_block, |block, &start| {
+            cancel.check()?;
             let rows = NN_BLOCK.min(query.nrows() - start);
             // n x rows, so that each query's column of dot products is contiguous.
-            let mut dots = Mat::<f32>::zeros(n, rows);
+            let mut dots = block.as_mut().subcols_mut(0, rows);
             matmul(
                 dots.as_mut(),
                 Accum::Replace,
@@ -491,7 +524,8 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
                 1.0,
                 Par::Seq,
             );
-            (0..rows)
+            let dots = dots.as_ref();
+            Ok((0..rows)
                 .map(|r| {
                     let column = dots
                         .col(r)
@@ -554,10 +588,10 @@ pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32>
                     }
                     winner.1
                 })
-                .collect()
+                .collect())
         })
-        .collect();
-    blocks.concat()
+        .collect::<Result<_>>()?;
+    Ok(blocks.concat())
 }
 
 /// Puts target `j` at squared distance `d` among the best [`RERANK`] so far (sorted, the
@@ -581,6 +615,16 @@ pub fn fmap_to_p2p(
     phi_a: MatRef<'_, f64>,
     phi_b: MatRef<'_, f64>,
 ) -> Vec<u32> {
+    fmap_to_p2p_cancellable(fmap_ab, phi_a, phi_b, &Cancel::default()).expect("never cancelled")
+}
+
+/// As [`fmap_to_p2p`], honouring `cancel` ([`nearest_rows_cancellable`]).
+pub(crate) fn fmap_to_p2p_cancellable(
+    fmap_ab: MatRef<'_, f64>,
+    phi_a: MatRef<'_, f64>,
+    phi_b: MatRef<'_, f64>,
+    cancel: &Cancel,
+) -> Result<Vec<u32>> {
     let (k_b, k_a) = (fmap_ab.nrows(), fmap_ab.ncols());
     let mut embedding_a = Mat::<f64>::zeros(phi_a.nrows(), k_b);
     matmul(
@@ -591,7 +635,7 @@ pub fn fmap_to_p2p(
         1.0,
         Par::Seq,
     );
-    nearest_rows(embedding_a.as_ref(), phi_b.subcols(0, k_b))
+    nearest_rows_cancellable(embedding_a.as_ref(), phi_b.subcols(0, k_b), cancel)
 }
 
 /// The functional map `C_ab = Phi_b^T M_b Pi_ba Phi_a` (`k_b x k_a`) of a pointwise map
@@ -708,8 +752,23 @@ pub fn zoomout(
     mass_b: &[f64],
     params: &ZoomOutParams,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
-    let run = ZoomOutRun::new(fmap_ab, phi_a, mass_a, phi_b, mass_b, params)?;
-    let p2p_ba = fmap_to_p2p(run.fmap_ab.as_ref(), phi_a, phi_b);
+    let bases = ((phi_a, mass_a), (phi_b, mass_b));
+    zoomout_cancellable(fmap_ab, bases, params, &Cancel::default())
+}
+
+/// A shape's eigenbasis (one row per vertex) and its vertex masses.
+pub(crate) type BasisRef<'a> = (MatRef<'a, f64>, &'a [f64]);
+
+/// As [`zoomout`], stopping with [`Error::Cancelled`] within an iteration once `cancel`
+/// is set.
+pub(crate) fn zoomout_cancellable(
+    fmap_ab: MatRef<'_, f64>,
+    (a, b): (BasisRef<'_>, BasisRef<'_>),
+    params: &ZoomOutParams,
+    cancel: &Cancel,
+) -> Result<(Mat<f64>, Vec<u32>)> {
+    let run = ZoomOutRun::new(fmap_ab, (a, b), params, cancel)?;
+    let p2p_ba = fmap_to_p2p_cancellable(run.fmap_ab.as_ref(), a.0, b.0, cancel)?;
     Ok((run.fmap_ab, p2p_ba))
 }
 
@@ -738,8 +797,20 @@ pub fn zoomout_on_samples(
     mass_b: &[f64],
     params: &ZoomOutParams,
 ) -> Result<SampledZoomOut> {
-    let run = ZoomOutRun::new(fmap_ab, phi_a, mass_a, phi_b, mass_b, params)?;
-    let p2p_sub = fmap_to_p2p(run.fmap_ab.as_ref(), run.sub_a.as_ref(), run.sub_b.as_ref());
+    let bases = ((phi_a, mass_a), (phi_b, mass_b));
+    zoomout_on_samples_cancellable(fmap_ab, bases, params, &Cancel::default())
+}
+
+/// As [`zoomout_on_samples`], honouring `cancel`.
+pub(crate) fn zoomout_on_samples_cancellable(
+    fmap_ab: MatRef<'_, f64>,
+    bases: (BasisRef<'_>, BasisRef<'_>),
+    params: &ZoomOutParams,
+    cancel: &Cancel,
+) -> Result<SampledZoomOut> {
+    let run = ZoomOutRun::new(fmap_ab, bases, params, cancel)?;
+    let (sub_a, sub_b) = (run.sub_a.as_ref(), run.sub_b.as_ref());
+    let p2p_sub = fmap_to_p2p_cancellable(run.fmap_ab.as_ref(), sub_a, sub_b, cancel)?;
     Ok(SampledZoomOut {
         p2p_ba: run.sample_a.on_vertices(&p2p_sub),
         fmap_ab: run.fmap_ab,
@@ -761,11 +832,9 @@ struct ZoomOutRun {
 impl ZoomOutRun {
     fn new(
         fmap_ab: MatRef<'_, f64>,
-        phi_a: MatRef<'_, f64>,
-        mass_a: &[f64],
-        phi_b: MatRef<'_, f64>,
-        mass_b: &[f64],
+        ((phi_a, mass_a), (phi_b, mass_b)): (BasisRef<'_>, BasisRef<'_>),
         params: &ZoomOutParams,
+        cancel: &Cancel,
     ) -> Result<ZoomOutRun> {
         let k_max = phi_a.ncols().min(phi_b.ncols());
         if params.step == 0
@@ -790,7 +859,8 @@ impl ZoomOutRun {
         while k < params.k_end {
             // Pointwise map on the samples with the current map, then the functional map one
             // step larger from it.
-            let p2p_sub = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref());
+            let p2p_sub =
+                fmap_to_p2p_cancellable(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref(), cancel)?;
             k = (k + params.step).min(params.k_end);
             fmap = weighted_fmap(
                 &sample_a.on_vertices(&p2p_sub),
@@ -865,6 +935,22 @@ pub fn icp_refine(
     iterations: usize,
     sample_size: usize,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
+    let bases = ((phi_a, mass_a), (phi_b, mass_b));
+    icp_refine_cancellable(
+        fmap_ab,
+        bases,
+        (iterations, sample_size),
+        &Cancel::default(),
+    )
+}
+
+/// As [`icp_refine`], honouring `cancel`.
+pub(crate) fn icp_refine_cancellable(
+    fmap_ab: MatRef<'_, f64>,
+    ((phi_a, mass_a), (phi_b, mass_b)): (BasisRef<'_>, BasisRef<'_>),
+    (iterations, sample_size): (usize, usize),
+    cancel: &Cancel,
+) -> Result<(Mat<f64>, Vec<u32>)> {
     let (k_b, k_a) = (fmap_ab.nrows(), fmap_ab.ncols());
     if k_a != k_b || k_a > phi_a.ncols().min(phi_b.ncols()) {
         return Err(Error::InvalidParameter {
@@ -880,7 +966,10 @@ pub fn icp_refine(
     let sample_b = Sample::of_size(mass_b, sample_size, SAMPLE_SEED + 1);
     let (sub_a, sub_b) = (sample_a.rows(phi_a, k_a), sample_b.rows(phi_b, k_b));
     let mut fmap = fmap_ab.to_owned();
-    let mut p2p = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref());
+    let convert = |fmap: &Mat<f64>, phi_a, phi_b| {
+        fmap_to_p2p_cancellable(fmap.as_ref(), phi_a, phi_b, cancel)
+    };
+    let mut p2p = convert(&fmap, sub_a.as_ref(), sub_b.as_ref())?;
     for _ in 0..iterations {
         let vertices = sample_a.on_vertices(&p2p);
         let c = weighted_fmap(&vertices, phi_a, sub_b.as_ref(), &sample_b.weights, k_a)?;
@@ -898,13 +987,13 @@ pub fn icp_refine(
             Par::Seq,
         );
         fmap = next;
-        let next_p2p = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref());
+        let next_p2p = convert(&fmap, sub_a.as_ref(), sub_b.as_ref())?;
         let unchanged = next_p2p == p2p;
         p2p = next_p2p;
         if unchanged {
             break;
         }
     }
-    let p2p_ba = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b);
+    let p2p_ba = convert(&fmap, phi_a, phi_b)?;
     Ok((fmap, p2p_ba))
 }

@@ -418,13 +418,11 @@ pub fn energies(
         1.0 / basis_b.input_area.sqrt(),
         &first.sample_b.vertices,
     );
+    let (va, vb) = (unit_size_vertices(a), unit_size_vertices(b));
     let oriented = faces.map(|(faces_a, faces_b)| {
-        let triangles_b = sample_triangles(
-            b.vertices(),
-            &vertex_normals(b.vertices(), faces_b),
-            &first.sample_b.vertices,
-        );
-        (vertex_normals(a.vertices(), faces_a), triangles_b)
+        let triangles_b =
+            sample_triangles(&vb, &vertex_normals(&vb, faces_b), &first.sample_b.vertices);
+        (vertex_normals(&va, faces_a), triangles_b)
     });
     sampled
         .iter()
@@ -434,7 +432,7 @@ pub fn energies(
             coverage: covered_vertices(&s.p2p_ba, a.n_vertices()) as f64
                 / s.sample_a.vertices.len().max(1) as f64,
             orientation: oriented.as_ref().map(|(normals_a, triangles_b)| {
-                sample_orientation((a.vertices(), normals_a), triangles_b, &s.p2p_ba)
+                sample_orientation((&va, normals_a), triangles_b, &s.p2p_ba)
             }),
         })
         .collect()
@@ -477,8 +475,9 @@ pub const FULL_MARGIN_SCALE: f64 = 0.05;
 /// Consistency of a full-resolution map from B to A: the fraction of A's active vertices it
 /// reaches times the fraction of B's oriented faces whose image keeps its orientation.
 pub fn full_consistency(a: &Shape, (faces_a, faces_b): &OrientedFaces, p2p_ba: &[u32]) -> f64 {
-    let normals_a = vertex_normals(a.vertices(), faces_a);
-    let kept = orientation_kept((a.vertices(), &normals_a), faces_b, p2p_ba).unwrap_or(0.0);
+    let va = unit_size_vertices(a);
+    let normals_a = vertex_normals(&va, faces_a);
+    let kept = orientation_kept((&va, &normals_a), faces_b, p2p_ba).unwrap_or(0.0);
     let reached = covered_vertices(p2p_ba, a.n_vertices()) as f64;
     reached / a.active_vertices().len().max(1) as f64 * kept
 }
@@ -697,8 +696,24 @@ fn sample_orientation(
 /// taken as [`Shape::oriented_triangles`]; `None` when either shape is a point cloud or
 /// not orientable, or no triangle maps to a proper triangle.
 pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
-    let normals_a = vertex_normals(a.vertices(), &a.oriented_triangles()?);
-    orientation_kept((a.vertices(), &normals_a), &b.oriented_triangles()?, p2p_ba)
+    let va = unit_size_vertices(a);
+    let normals_a = vertex_normals(&va, &a.oriented_triangles()?);
+    orientation_kept((&va, &normals_a), &b.oriented_triangles()?, p2p_ba)
+}
+
+/// The shape's vertices, divided by a power of two near its size (exact) when it is far
+/// from unit size: a normal is a product of two lengths and the orientation test a product
+/// of two normals, which underflow to 0 on a 1e-100-scaled shape (its confidence was 0:
+/// issue 19). Shapes of ordinary size are used as they are.
+fn unit_size_vertices(shape: &Shape) -> std::borrow::Cow<'_, [[f64; 3]]> {
+    let vertices = shape.vertices();
+    let (lo, hi) = crate::shape::bounding_box(vertices);
+    let size = (0..3).fold(0.0f64, |m, k| m.max(hi[k] - lo[k]));
+    if (1e-50..1e50).contains(&size) {
+        return std::borrow::Cow::Borrowed(vertices);
+    }
+    let scale = crate::shape::power_of_two_near(size);
+    std::borrow::Cow::Owned(vertices.iter().map(|p| p.map(|x| x / scale)).collect())
 }
 
 /// Fraction of `faces_b` whose image under `p2p_ba` keeps its orientation against A's vertex

@@ -13,12 +13,13 @@ use rayon::prelude::*;
 
 use crate::correspondence::{Correspondence, Params};
 use crate::maps::fmap::{
-    fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, project,
-    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
+    fmap_to_p2p_cancellable, icp_refine_cancellable, multiplication_operators,
+    orientation_operators, project, solve_fmap_commuting_cancellable, zoomout_cancellable,
+    zoomout_on_samples_cancellable, Commutativity, ZoomOutParams,
 };
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, HypothesisKind, RegionGroups, Verdict};
-use crate::progress::{check, Progress, Stage};
+use crate::progress::{check, polled, Cancel, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
 use crate::spectral::eigen::{EigenParams, Eigenbasis};
@@ -215,6 +216,38 @@ impl PointwiseMap {
         regions: Option<&Correspondence>,
         params: &PointwiseParams,
     ) -> Result<PointwiseMap> {
+        let cancel = Cancel::default();
+        PointwiseMap::from_bases_cancellable((a, basis_a), (b, basis_b), regions, params, &cancel)
+    }
+
+    /// As [`PointwiseMap::from_bases`], reporting progress to `progress` as `stage` (from
+    /// the caller's thread, every [`crate::progress::POLL_INTERVAL`]) and stopping within a
+    /// fraction of a second when it cancels: every loop inside checks the cancel (issue 19).
+    pub fn from_bases_with_progress(
+        (a, basis_a): (&Shape, &Eigenbasis),
+        (b, basis_b): (&Shape, &Eigenbasis),
+        regions: Option<&Correspondence>,
+        params: &PointwiseParams,
+        (progress, stage): (&mut dyn Progress, Stage),
+    ) -> Result<PointwiseMap> {
+        polled(progress, stage, (0.0, 1.0), |cancel| {
+            PointwiseMap::from_bases_cancellable(
+                (a, basis_a),
+                (b, basis_b),
+                regions,
+                params,
+                cancel,
+            )
+        })
+    }
+
+    fn from_bases_cancellable(
+        (a, basis_a): (&Shape, &Eigenbasis),
+        (b, basis_b): (&Shape, &Eigenbasis),
+        regions: Option<&Correspondence>,
+        params: &PointwiseParams,
+        cancel: &Cancel,
+    ) -> Result<PointwiseMap> {
         params.validate()?;
         let started = Instant::now();
         let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
@@ -266,10 +299,13 @@ impl PointwiseMap {
             params,
             k,
         )?;
+        cancel.check()?;
+        cancel.set_fraction(0.2);
         let fmaps = (0..candidates.len())
             .into_par_iter()
-            .map(|c| features.solve(c, basis_a, basis_b, params))
+            .map(|c| features.solve(c, (basis_a, basis_b), params, cancel))
             .collect::<Result<Vec<_>>>()?;
+        cancel.set_fraction(0.4);
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
         let (fmap_ab, p2p_ba, verdict) = if fmaps.len() > 1 {
@@ -279,27 +315,35 @@ impl PointwiseMap {
                 faces.as_ref(),
                 kinds,
                 &fmaps,
-                params,
-                k,
+                (params, k),
+                cancel,
             )?;
+            cancel.set_fraction(0.8);
             let (fmap_ab, p2p_ba) = match &params.refinement {
                 // The chosen map is already refined on the samples.
                 Refinement::ZoomOut(_) => {
                     let fmap = verdict.scores[verdict.chosen].fmap_ab.clone();
-                    let p2p = chosen_map.unwrap_or_else(|| {
-                        fmap_to_p2p(
+                    let p2p = match chosen_map {
+                        Some(p2p) => p2p,
+                        None => fmap_to_p2p_cancellable(
                             fmap.as_ref(),
                             basis_a.vectors.as_ref(),
                             basis_b.vectors.as_ref(),
-                        )
-                    });
+                            cancel,
+                        )?,
+                    };
                     (fmap, p2p)
                 }
-                _ => refine(&fmaps[verdict.chosen], (basis_a, basis_b), params, k)?,
+                _ => refine(
+                    &fmaps[verdict.chosen],
+                    (basis_a, basis_b),
+                    (params, k),
+                    cancel,
+                )?,
             };
             (fmap_ab, p2p_ba, Some(verdict))
         } else {
-            let (fmap_ab, p2p_ba) = refine(&fmaps[0], (basis_a, basis_b), params, k)?;
+            let (fmap_ab, p2p_ba) = refine(&fmaps[0], (basis_a, basis_b), (params, k), cancel)?;
             (fmap_ab, p2p_ba, None)
         };
         Ok(PointwiseMap {
@@ -353,29 +397,27 @@ fn clamped(
 fn refine(
     fmap: &Mat<f64>,
     (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
-    params: &PointwiseParams,
-    k: usize,
+    (params, k): (&PointwiseParams, usize),
+    cancel: &Cancel,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+    let bases = (
+        (phi_a, basis_a.mass.as_slice()),
+        (phi_b, basis_b.mass.as_slice()),
+    );
     match &params.refinement {
-        Refinement::None => Ok((fmap.clone(), fmap_to_p2p(fmap.as_ref(), phi_a, phi_b))),
-        Refinement::ZoomOut(z) => zoomout(
-            fmap.as_ref(),
-            phi_a,
-            &basis_a.mass,
-            phi_b,
-            &basis_b.mass,
-            &clamped(z, (basis_a, basis_b), k),
-        ),
-        Refinement::Icp(iterations) => icp_refine(
-            fmap.as_ref(),
-            phi_a,
-            &basis_a.mass,
-            phi_b,
-            &basis_b.mass,
-            *iterations,
-            ZoomOutParams::default().sample_size,
-        ),
+        Refinement::None => {
+            let p2p = fmap_to_p2p_cancellable(fmap.as_ref(), phi_a, phi_b, cancel)?;
+            Ok((fmap.clone(), p2p))
+        }
+        Refinement::ZoomOut(z) => {
+            let z = clamped(z, (basis_a, basis_b), k);
+            zoomout_cancellable(fmap.as_ref(), bases, &z, cancel)
+        }
+        Refinement::Icp(iterations) => {
+            let sample_size = ZoomOutParams::default().sample_size;
+            icp_refine_cancellable(fmap.as_ref(), bases, (*iterations, sample_size), cancel)
+        }
     }
 }
 
@@ -387,10 +429,14 @@ fn verified(
     faces: Option<&hypotheses::OrientedFaces>,
     kinds: Vec<HypothesisKind>,
     fmaps: &[Mat<f64>],
-    params: &PointwiseParams,
-    k: usize,
+    (params, k): (&PointwiseParams, usize),
+    cancel: &Cancel,
 ) -> Result<(Verdict, Option<Vec<u32>>)> {
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+    let bases = (
+        (phi_a, basis_a.mass.as_slice()),
+        (phi_b, basis_b.mass.as_slice()),
+    );
     let decision = match &params.refinement {
         Refinement::ZoomOut(z) => z.clone(),
         _ => ZoomOutParams::default(),
@@ -398,17 +444,9 @@ fn verified(
     let decision = clamped(&decision, (basis_a, basis_b), k);
     let sampled = fmaps
         .par_iter()
-        .map(|fmap| {
-            zoomout_on_samples(
-                fmap.as_ref(),
-                phi_a,
-                &basis_a.mass,
-                phi_b,
-                &basis_b.mass,
-                &decision,
-            )
-        })
+        .map(|fmap| zoomout_on_samples_cancellable(fmap.as_ref(), bases, &decision, cancel))
         .collect::<Result<Vec<_>>>()?;
+    cancel.check()?;
     let energies = hypotheses::energies((a, basis_a), (b, basis_b), faces, &sampled);
     let sample_maps: Vec<&[u32]> = sampled.iter().map(|s| s.p2p_ba.as_slice()).collect();
     let sample_fmaps = sampled.iter().map(|s| s.fmap_ab.clone()).collect();
@@ -422,8 +460,11 @@ fn verified(
     // A close call is decided at full resolution, where the meshes' orientation is known.
     let mut chosen_map = None;
     if let (Some(rival), Some(faces)) = (verdict.close_call(), faces) {
-        let [chosen_p2p, rival_p2p] = [verdict.chosen, rival]
-            .map(|h| fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b));
+        cancel.check()?;
+        let convert = |h: usize| {
+            fmap_to_p2p_cancellable(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel)
+        };
+        let (chosen_p2p, rival_p2p) = (convert(verdict.chosen)?, convert(rival)?);
         let consistency = (
             hypotheses::full_consistency(a, faces, &chosen_p2p),
             hypotheses::full_consistency(a, faces, &rival_p2p),
@@ -610,9 +651,9 @@ impl Features {
     fn solve(
         &self,
         c: usize,
-        basis_a: &Eigenbasis,
-        basis_b: &Eigenbasis,
+        (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
         params: &PointwiseParams,
+        cancel: &Cancel,
     ) -> Result<Mat<f64>> {
         let pairs = &self.candidates[c];
         let gather = |side: &SideFeatures, a_side: bool| {
@@ -633,12 +674,10 @@ impl Features {
         };
         let (coef_a, multiplication_a, orientation_a) = gather(&self.a, true);
         let (coef_b, multiplication_b, orientation_b) = gather(&self.b, false);
-        solve_fmap_commuting(
+        solve_fmap_commuting_cancellable(
             coef_a.as_ref(),
             coef_b.as_ref(),
-            &basis_a.values,
-            &basis_b.values,
-            params.laplacian_weight,
+            (&basis_a.values, &basis_b.values, params.laplacian_weight),
             &[
                 Commutativity {
                     operators_a: &multiplication_a,
@@ -651,6 +690,7 @@ impl Features {
                     weight: params.orientation_term,
                 },
             ],
+            cancel,
         )
     }
 }
@@ -697,17 +737,52 @@ impl PointwiseCorrespondence {
     ) -> Result<PointwiseCorrespondence> {
         params.validate()?;
         pointwise.validate()?;
-        let started = Instant::now();
-        let eigen = EigenParams {
-            n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
-            ..params.eigen.clone()
+        let eigen = basis_params(params, pointwise);
+        params
+            .budget
+            .check(&PointwiseCorrespondence::job(a, b, params, pointwise))?;
+        params.budget.run(progress, |progress| {
+            PointwiseCorrespondence::compute_within((a, b), &eigen, params, pointwise, progress)
+        })
+    }
+
+    /// What [`PointwiseCorrespondence::compute`] will do on these shapes, for
+    /// [`crate::budget::Budget::check`]: the chosen map converted at full resolution, and a
+    /// close call's rival too when the hypotheses are verified.
+    pub fn job(
+        a: &Shape,
+        b: &Shape,
+        params: &Params,
+        pointwise: &PointwiseParams,
+    ) -> crate::budget::Job {
+        let eigen = basis_params(params, pointwise);
+        let size = match &pointwise.refinement {
+            Refinement::ZoomOut(z) => z.k_end,
+            _ => pointwise.fmap_size,
         };
+        let sizes = [a, b].map(|s| s.active_vertices().len());
+        crate::budget::Job {
+            conversions: if params.verify_hypotheses { 3 } else { 1 },
+            conversion_size: size.min(eigen.n_eigenpairs),
+            ..crate::budget::regions_job(sizes, &eigen, false)
+        }
+    }
+
+    /// [`PointwiseCorrespondence::compute`] once the budget has accepted the job.
+    fn compute_within(
+        (a, b): (&Shape, &Shape),
+        eigen: &EigenParams,
+        params: &Params,
+        pointwise: &PointwiseParams,
+        progress: &mut dyn Progress,
+    ) -> Result<PointwiseCorrespondence> {
+        let started = Instant::now();
         let basis_a =
-            Eigenbasis::compute_with_progress(a, &eigen, progress).map_err(|e| e.in_shape('A'))?;
+            Eigenbasis::compute_with_progress(a, eigen, progress).map_err(|e| e.in_shape('A'))?;
         let eigenbasis_a = started.elapsed().as_secs_f64();
         let t = Instant::now();
         let basis_b =
-            Eigenbasis::compute_with_progress(b, &eigen, progress).map_err(|e| e.in_shape('B'))?;
+            Eigenbasis::compute_with_progress(b, eigen, progress).map_err(|e| e.in_shape('B'))?;
         let eigenbasis_b = t.elapsed().as_secs_f64();
         let (regions, map) =
             regions_and_map((a, &basis_a), (b, &basis_b), params, pointwise, progress)?;
@@ -718,6 +793,15 @@ impl PointwiseCorrespondence {
             eigenbasis_b,
             total: started.elapsed().as_secs_f64(),
         })
+    }
+}
+
+/// The eigensolver's parameters of a pointwise job: enough eigenpairs for the map and the
+/// regions, computed once per shape.
+fn basis_params(params: &Params, pointwise: &PointwiseParams) -> EigenParams {
+    EigenParams {
+        n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
+        ..params.eigen.clone()
     }
 }
 
@@ -752,7 +836,13 @@ pub fn regions_and_map(
         orientation: pointwise.orientation && params.verify_hypotheses,
         ..pointwise.clone()
     };
-    let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(&regions), &pointwise)?;
+    let map = PointwiseMap::from_bases_with_progress(
+        (a, basis_a),
+        (b, basis_b),
+        Some(&regions),
+        &pointwise,
+        (progress, Stage::PointwiseMap),
+    )?;
     if let Some(verdict) = &map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(&regions, &map.p2p_ba, &basis_b.mass);
@@ -771,6 +861,7 @@ pub fn verify_regions(
     (a, basis_a): (&Shape, &Eigenbasis),
     (b, basis_b): (&Shape, &Eigenbasis),
     regions: &mut Correspondence,
+    progress: &mut dyn Progress,
 ) -> Result<()> {
     if regions.matches_one_to_one.is_empty() {
         return Ok(());
@@ -786,7 +877,13 @@ pub fn verify_regions(
         }),
         ..defaults
     };
-    let map = PointwiseMap::from_bases(a, basis_a, b, basis_b, Some(regions), &params)?;
+    let map = PointwiseMap::from_bases_with_progress(
+        (a, basis_a),
+        (b, basis_b),
+        Some(regions),
+        &params,
+        (progress, Stage::SymmetryBreaking),
+    )?;
     if let Some(verdict) = map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(regions, &map.p2p_ba, &basis_b.mass);

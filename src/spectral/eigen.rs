@@ -183,20 +183,12 @@ pub fn eigensolver_bytes(n: usize, params: &EigenParams) -> u64 {
     n as u64 * vectors * 8
 }
 
-/// The memory the system can give now (`MemAvailable`), where it says (Linux).
-fn available_bytes() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_ascii_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
 /// Refuses a shape above [`EigenParams::max_vertices`], or one whose eigenbasis needs more
 /// memory than the system has, before anything is allocated.
 fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
     let n = shape.active_vertices().len();
     let needed = eigensolver_bytes(n, params);
-    if let Some(available) = available_bytes().filter(|&a| needed > a) {
+    if let Some(available) = crate::budget::available_bytes().filter(|&a| needed > a) {
         let gb = |b: u64| b as f64 / 1e9;
         return Err(Error::InvalidParameter {
             name: "eigenpairs",

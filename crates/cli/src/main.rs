@@ -74,6 +74,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     output::QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
     // The whole command runs on a worker of one rayon pool: parallel loops called from
@@ -83,6 +84,17 @@ fn main() -> ExitCode {
     match rayon::ThreadPoolBuilder::new().build() {
         Ok(pool) => pool.install(|| run(&cli)),
         Err(_) => run(&cli),
+    }
+}
+
+/// `shapecorr info F | head -1`: when the reader closes the pipe, end as every Unix tool
+/// does (killed by SIGPIPE, no message) instead of panicking in `println!`. Rust ignores
+/// SIGPIPE by default, which turns the closed pipe into a panic (issue 19).
+fn quit_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: restoring a signal's default disposition at start-up, before any thread.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

@@ -113,6 +113,25 @@ pub fn graph_json(graph: &ShapeGraph) -> serde_json::Value {
     })
 }
 
+/// Peak resident memory of this process (Linux `VmHWM`), in MiB.
+pub fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// `result.json`'s `budget`: the job's estimated peak memory and time (what the memory
+/// ceiling and the time limit were checked against) and the process's measured peak.
+pub fn budget_json(job: &shapecorr::budget::Job) -> serde_json::Value {
+    let estimate = shapecorr::budget::estimate(job);
+    json!({
+        "memory_estimate_mib": estimate.mib(),
+        "time_estimate_s": estimate.seconds,
+        "peak_memory_mib": peak_memory_mib(),
+    })
+}
+
 /// What `result.json` records of a region correspondence, with [`set_verdict_json`]'s keys.
 pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> serde_json::Value {
     let mut value = json!({

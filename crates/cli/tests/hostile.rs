@@ -241,3 +241,105 @@ fn progress_is_written_as_lines_when_stderr_is_not_a_terminal() {
     assert!(quiet.status.success());
     assert!(!stderr(&quiet).contains("progress"), "{}", stderr(&quiet));
 }
+
+#[test]
+fn a_closed_pipe_ends_the_tool_quietly() {
+    let dir = scratch("pipe");
+    let shape = dir.join("h.ply");
+    synth(&shape, "0");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shapecorr"))
+        .args(["eigen", shape.to_str().unwrap(), "--k", "20"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes away before the tool prints (as `| head -0`): every line it then
+    // writes meets a closed pipe.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "panicked: {err}");
+}
+
+fn result_json(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap()
+}
+
+/// Issue 19, item 3: a memory ceiling below the job's estimate is refused before any work,
+/// naming `memory_limit_mib`; at a ceiling the estimate fits, the job runs and its measured
+/// peak stays within 10% of the ceiling (`result.json`'s `budget`).
+#[test]
+fn the_memory_ceiling_refuses_at_once_and_holds() {
+    let dir = scratch("ceiling");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth(&a, "0");
+    synth(&b, "3");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    for command in ["match", "p2p"] {
+        let out_dir = dir.join(command);
+        let out = out_dir.to_str().unwrap();
+        let free = shapecorr(&[command, a, b, "--out", out, "--quiet"]);
+        assert!(free.status.success(), "{}", stderr(&free));
+        let estimate = result_json(&out_dir)["budget"]["memory_estimate_mib"]
+            .as_f64()
+            .unwrap();
+        let below = format!("{}", estimate.floor() as u64 - 1);
+        let started = Instant::now();
+        let refused = shapecorr(&[
+            command,
+            a,
+            b,
+            "--out",
+            out,
+            "--quiet",
+            "--memory-limit-mib",
+            &below,
+        ]);
+        assert_clean_failure(&refused, &["memory_limit_mib", "MiB", "raise"]);
+        assert!(started.elapsed() < Duration::from_secs(2), "not at once");
+        let ceiling = estimate.ceil() as u64;
+        let at = format!("{ceiling}");
+        let fits = shapecorr(&[
+            command,
+            a,
+            b,
+            "--out",
+            out,
+            "--quiet",
+            "--memory-limit-mib",
+            &at,
+        ]);
+        assert!(fits.status.success(), "{}", stderr(&fits));
+        let peak = result_json(&out_dir)["budget"]["peak_memory_mib"]
+            .as_f64()
+            .unwrap();
+        println!("{command}: ceiling {ceiling} MiB, peak {peak:.1} MiB");
+        assert!(
+            peak <= 1.1 * ceiling as f64,
+            "{peak} MiB over {ceiling} MiB"
+        );
+    }
+}
+
+/// A time limit the job's estimate exceeds is refused at once, naming `time_limit_s`.
+#[test]
+fn a_time_limit_below_the_estimate_is_refused_at_once() {
+    let dir = scratch("time-limit");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth(&a, "0");
+    synth(&b, "3");
+    let out = dir.join("out");
+    let started = Instant::now();
+    let refused = shapecorr(&[
+        "p2p",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--time-limit-s",
+        "0.001",
+    ]);
+    assert_clean_failure(&refused, &["time_limit_s", "would take about"]);
+    assert!(started.elapsed() < Duration::from_secs(2), "not at once");
+}

@@ -1,6 +1,7 @@
 //! `shapecorr eigen`: Laplacian eigenvalues of a shape, with time and peak memory.
 
 use crate::input::read_shape;
+use crate::output::peak_memory_mib;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -122,12 +123,4 @@ fn export_problem(
     let x_path = dir.join("eigenvectors.f64");
     std::fs::write(&x_path, bytes).map_err(|e| io_error(&x_path, e))?;
     Ok(())
-}
-
-/// Peak resident memory of this process (Linux `VmHWM`), in MiB.
-fn peak_memory_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
 }

@@ -10,9 +10,9 @@ use crate::commands::naming_files;
 use crate::input::read_input;
 use crate::options::PointwiseOptions;
 use crate::output::{
-    confidence_summary, correspondence_json, create_dir, end_progress_line, options_json,
-    print_warning, set_verdict_json, write_colored, write_json, write_map, write_map_colors,
-    TerminalProgress,
+    budget_json, confidence_summary, correspondence_json, create_dir, end_progress_line,
+    options_json, print_warning, set_verdict_json, write_colored, write_json, write_map,
+    write_map_colors, TerminalProgress,
 };
 
 #[derive(clap::Args)]
@@ -61,6 +61,8 @@ impl P2pArgs {
         value["fmap_size"] = json!(result.map.fmap_ab.nrows());
         value["options"] = options_json(&options, true);
         value["region_times"] = json!(pointwise.region_times);
+        let job = PointwiseCorrespondence::job(&shape_a, &shape_b, &options.params, &pointwise);
+        value["budget"] = budget_json(&job);
         // The answer's verdict: the map's own when it verified hypotheses, else the regions'.
         set_verdict_json(&mut value, result.verdict());
         write_json(&out.join("result.json"), &value)?;

@@ -11,8 +11,8 @@ use crate::commands::naming_files;
 use crate::input::read_input;
 use crate::options::RegionOptions;
 use crate::output::{
-    confidence_summary, correspondence_json, create_dir, end_progress_line, graph_json,
-    options_json, print_warning, write_colored, write_json, TerminalProgress,
+    budget_json, confidence_summary, correspondence_json, create_dir, end_progress_line,
+    graph_json, options_json, print_warning, write_colored, write_json, TerminalProgress,
 };
 
 #[derive(clap::Args)]
@@ -50,6 +50,7 @@ impl MatchArgs {
         let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
         value["options"] = options_json(&options, false);
+        value["budget"] = budget_json(&Correspondence::job(&shape_a, &shape_b, &options.params));
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result)?;
         println!(

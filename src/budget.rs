@@ -1,0 +1,266 @@
+//! What one job may use: a memory ceiling and a time limit (issue 19). Both are checked
+//! against an estimate before any work, so a job that cannot fit is refused at once with
+//! the reason; the time limit is also enforced while the job runs, through the same checks
+//! that honour a cancel (within a fraction of a second in every long stage).
+//!
+//! The estimates are models of what the pipeline allocates and computes, with constants
+//! measured on generated humanoids (docs/decisions.md, "Budget"): the peak memory of the
+//! eigensolver (the Lanczos vectors and the Cholesky factor), of the eigenbases kept for
+//! the pair, and of the full-resolution conversions of functional maps to vertex maps; the
+//! time of the eigensolves and of those conversions, which are quadratic in the vertex
+//! count (`n_a n_b k` products) and so decide what a large pair costs.
+
+use std::time::{Duration, Instant};
+
+use crate::progress::{Progress, Stage};
+use crate::spectral::eigen::{effective_threads, eigensolver_bytes, EigenParams};
+use crate::{Error, Result};
+
+/// The limits of one job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Budget {
+    /// Largest estimated peak memory, in MiB; 0 (the default) is the memory the system has
+    /// available when the job starts (`MemAvailable`; no limit where the system does not
+    /// say).
+    pub memory_limit_mib: u64,
+    /// Longest a job may run, in seconds; 0 is no limit. Default [`DEFAULT_TIME_LIMIT_S`].
+    pub time_limit_s: f64,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
+}
+
+/// Default [`Budget::time_limit_s`]: half an hour. A 100K-vertex pair takes minutes here
+/// and a 2M-vertex pair hours (its vertex maps alone are 4e14 products), which a user should
+/// hear at once rather than after waiting.
+pub const DEFAULT_TIME_LIMIT_S: f64 = 1800.0;
+
+impl Default for Budget {
+    fn default() -> Self {
+        Budget {
+            memory_limit_mib: 0,
+            time_limit_s: DEFAULT_TIME_LIMIT_S,
+            non_exhaustive: crate::NonExhaustive(()),
+        }
+    }
+}
+
+/// What a job will take, estimated before it starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Estimate {
+    /// Peak memory, in bytes.
+    pub bytes: u64,
+    /// Wall time on the reference machine (2 cores), in seconds.
+    pub seconds: f64,
+}
+
+impl Estimate {
+    /// The estimated peak memory in MiB.
+    pub fn mib(&self) -> f64 {
+        self.bytes as f64 / MIB
+    }
+}
+
+/// The work of one job: the two shapes' sizes and what is computed on them.
+#[derive(Debug, Clone, Copy)]
+pub struct Job {
+    /// Active vertices of shape A and shape B (the same shape twice for a symmetry job).
+    pub vertices: [usize; 2],
+    /// Eigenpairs computed per shape.
+    pub eigenpairs: usize,
+    /// Full-resolution conversions of a functional map to a vertex map (each `n_a n_b k`
+    /// products), and the size `k` of those maps.
+    pub conversions: usize,
+    /// Functional map size of the conversions.
+    pub conversion_size: usize,
+    /// Threads of the dense products.
+    pub threads: usize,
+}
+
+const MIB: f64 = 1024.0 * 1024.0;
+
+/// Memory of the process before any shape: code, thread stacks, allocator pools. Measured:
+/// `shapecorr info` on a 3K-vertex shape peaks at 20 MiB; a 5K pair's `p2p` at 153 MiB
+/// of which the model below accounts for 70.
+const BASE_BYTES: u64 = 90 << 20;
+
+/// Bytes per vertex of everything else a job holds per shape: positions, faces, neighbours,
+/// repair maps, the Laplacian, descriptors, the regions' indicator and operator matrices,
+/// and what the allocator keeps of the parallel stages' scratch. Measured: the peak of the
+/// same 20K-vertex `match` varies from 225 to 386 MiB between runs (thread timing and
+/// the allocator's per-thread arenas); this constant keeps the estimate above every peak
+/// measured on generated humanoids of 3K-50K vertices (docs/decisions.md, "Budget").
+const SHAPE_BYTES_PER_VERTEX: u64 = 4500;
+
+/// Nonzeros of the Cholesky factor per vertex (nested dissection on surface meshes; faer's
+/// supernodal factor of 5K-100K-vertex humanoids holds 25-45 per vertex).
+const FACTOR_NONZEROS_PER_VERTEX: u64 = 60;
+
+/// Queries per block of the dense nearest-neighbour search (`maps::fmap`'s `NN_BLOCK`):
+/// each thread holds one `n_a x block` distance block in single precision.
+const CONVERSION_BLOCK: u64 = 256;
+
+/// Multiply-adds per second and thread of the single-precision products of a conversion,
+/// measured with `p2p` at 50K vertices on a 2-core AMD EPYC (about 1.5e11 products a
+/// conversion, 48 s for three of them with the hypotheses' sample refinements).
+const CONVERSION_PRODUCTS_PER_SECOND: f64 = 8e9;
+
+/// Seconds per vertex, eigenpair and doubling of the size for one eigensolve (shift-invert
+/// Lanczos): 0.9 s for 20K vertices and 50 eigenpairs, 6-15 s for 50K and 50-100.
+const EIGEN_SECONDS: f64 = 1e-7;
+
+/// The job's estimated peak memory and time.
+pub fn estimate(job: &Job) -> Estimate {
+    let [n_a, n_b] = job.vertices.map(|n| n as u64);
+    let k = job.eigenpairs as u64;
+    let largest = n_a.max(n_b);
+    let eigen = EigenParams {
+        n_eigenpairs: job.eigenpairs.max(1),
+        ..Default::default()
+    };
+    // Both shapes and their bases are kept for the pair; one eigensolve runs at a time.
+    let kept = (n_a + n_b) * (SHAPE_BYTES_PER_VERTEX + 8 * k.min(largest));
+    let eigensolve =
+        eigensolver_bytes(largest as usize, &eigen) + largest * FACTOR_NONZEROS_PER_VERTEX * 12;
+    let conversion = if job.conversions > 0 {
+        let c = job.conversion_size as u64;
+        // The embedding of A (double and single precision, row-major copy) and B's rows,
+        // then one distance block per thread.
+        (n_a + n_b) * c * 20 + job.threads as u64 * n_a * CONVERSION_BLOCK * 4
+    } else {
+        0
+    };
+    let bytes = BASE_BYTES + kept + eigensolve.max(conversion);
+    let doublings = |n: u64| (n.max(2) as f64).log2();
+    let eigen_seconds = [n_a, n_b]
+        .map(|n| EIGEN_SECONDS * (n * k) as f64 * doublings(n))
+        .iter()
+        .sum::<f64>();
+    let products = job.conversions as f64 * (n_a * n_b * job.conversion_size as u64) as f64;
+    let conversion_seconds = products / (CONVERSION_PRODUCTS_PER_SECOND * job.threads as f64);
+    Estimate {
+        bytes,
+        seconds: eigen_seconds + conversion_seconds,
+    }
+}
+
+/// The memory the system can give now (`MemAvailable`), where it says (Linux).
+pub fn available_bytes() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_ascii_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+impl Budget {
+    /// The memory ceiling in bytes: the configured one, or what the system has available.
+    pub fn memory_limit_bytes(&self) -> Option<u64> {
+        if self.memory_limit_mib > 0 {
+            Some(self.memory_limit_mib.saturating_mul(1 << 20))
+        } else {
+            available_bytes()
+        }
+    }
+
+    /// Refuses a job whose estimate exceeds the memory ceiling or the time limit, naming
+    /// the option and what to do.
+    pub fn check(&self, job: &Job) -> Result<Estimate> {
+        let estimate = estimate(job);
+        let [n_a, n_b] = job.vertices;
+        let pair = if n_a == n_b {
+            format!("{n_a}-vertex shapes")
+        } else {
+            format!("{n_a}- and {n_b}-vertex shapes")
+        };
+        if let Some(limit) = self.memory_limit_bytes() {
+            if estimate.bytes > limit {
+                return Err(Error::InvalidParameter {
+                    name: "memory_limit_mib",
+                    reason: format!(
+                        "the job on {pair} needs about {:.0} MiB, more than the {} {:.0} MiB; \
+                         simplify the shapes, ask for fewer eigenpairs or raise \
+                         memory_limit_mib",
+                        estimate.mib(),
+                        if self.memory_limit_mib > 0 {
+                            "ceiling of"
+                        } else {
+                            "memory available,"
+                        },
+                        limit as f64 / MIB
+                    ),
+                });
+            }
+        }
+        if self.time_limit_s > 0.0 && estimate.seconds > self.time_limit_s {
+            return Err(Error::InvalidParameter {
+                name: "time_limit_s",
+                reason: format!(
+                    "the job on {pair} would take about {:.0} s on a 2-core machine, more \
+                     than time_limit_s = {} s; simplify the shapes or raise time_limit_s \
+                     (0: no limit)",
+                    estimate.seconds, self.time_limit_s
+                ),
+            });
+        }
+        Ok(estimate)
+    }
+
+    /// Runs `work` with `progress` wrapped so that it also stops the work once the time
+    /// limit has passed; the work's cancel then becomes the error naming `time_limit_s`.
+    pub fn run<T>(
+        &self,
+        progress: &mut dyn Progress,
+        work: impl FnOnce(&mut dyn Progress) -> Result<T>,
+    ) -> Result<T> {
+        if self.time_limit_s <= 0.0 {
+            return work(progress);
+        }
+        let mut watched = Deadline {
+            inner: progress,
+            deadline: Instant::now() + Duration::from_secs_f64(self.time_limit_s),
+            passed_in: None,
+        };
+        let result = work(&mut watched);
+        match (result, watched.passed_in) {
+            (Err(Error::Cancelled), Some(stage)) => Err(Error::InvalidParameter {
+                name: "time_limit_s",
+                reason: format!(
+                    "the job ran past time_limit_s = {} s (in stage {stage:?}) and was \
+                     stopped; raise time_limit_s (0: no limit) or simplify the shapes",
+                    self.time_limit_s
+                ),
+            }),
+            (result, _) => result,
+        }
+    }
+}
+
+/// A progress that says stop once its deadline has passed.
+struct Deadline<'a> {
+    inner: &'a mut dyn Progress,
+    deadline: Instant,
+    passed_in: Option<Stage>,
+}
+
+impl Progress for Deadline<'_> {
+    fn report(&mut self, stage: Stage, fraction: f32) -> bool {
+        if Instant::now() >= self.deadline {
+            self.passed_in.get_or_insert(stage);
+            return false;
+        }
+        self.inner.report(stage, fraction)
+    }
+}
+
+/// The job of a region correspondence (`Correspondence::compute`; `verify` when its
+/// hypotheses are verified by maps, which converts up to three of them at full resolution).
+pub fn regions_job(vertices: [usize; 2], eigen: &EigenParams, verify: bool) -> Job {
+    Job {
+        vertices,
+        eigenpairs: eigen.n_eigenpairs,
+        conversions: if verify { 3 } else { 0 },
+        conversion_size: eigen.n_eigenpairs,
+        threads: effective_threads(eigen.threads),
+    }
+}
