@@ -17,9 +17,9 @@ use shapecorr::shape::io::RawShape;
 use shapecorr::{ReadAs, Shape};
 
 /// Most vertices and polygons decoded (keeps one execution short).
-pub const MAX_VERTICES: usize = 600;
+pub const MAX_VERTICES: usize = 200;
 /// Most polygons decoded.
-pub const MAX_POLYGONS: usize = 1200;
+pub const MAX_POLYGONS: usize = 400;
 
 /// Reads fuzz input; past the end every read gives 0.
 pub struct Bytes<'a>(pub &'a [u8]);

@@ -46,7 +46,7 @@ for t in "${targets[@]}"; do
     # input a failure; -rss_limit_mb (also the largest single allocation) makes an
     # unbounded allocation one.
     if cargo +nightly fuzz run "$t" -- -max_total_time="$seconds" \
-        -max_len=65536 -timeout=20 -rss_limit_mb=2048 -print_final_stats=1 >"$log" 2>&1; then
+        -max_len=16384 -timeout=20 -rss_limit_mb=2048 -print_final_stats=1 >"$log" 2>&1; then
         status=ok
     else
         status=FAILED
