@@ -114,7 +114,14 @@ pub fn weld(points: &[[f64; 3]], of: &[u32], tolerance: f64) -> Vec<u32> {
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    let Some(others) = grid.get(&[x + dx, y + dy, z + dz]) else {
+                    // A point far beyond the tolerance saturates its cell at i64::MIN/MAX,
+                    // which has no neighbour past it.
+                    let (Some(a), Some(b), Some(c)) =
+                        (x.checked_add(dx), y.checked_add(dy), z.checked_add(dz))
+                    else {
+                        continue;
+                    };
+                    let Some(others) = grid.get(&[a, b, c]) else {
                         continue;
                     };
                     for &w in others {
