@@ -80,21 +80,22 @@ pub struct Job {
 
 const MIB: f64 = 1024.0 * 1024.0;
 
-/// Memory of the process before any shape: code, thread stacks, allocator pools. Measured:
-/// `shapecorr info` on a 3K-vertex shape peaks at 20 MiB; a 5K pair's `p2p` at 153 MiB
-/// of which the model below accounts for 70.
+/// Memory of the process before any shape: code, thread stacks, allocator pools. Chosen so
+/// that the 3K-5K-vertex pairs' measured peaks (63-153 MiB) stay under the estimate.
 const BASE_BYTES: u64 = 90 << 20;
 
 /// Bytes per vertex of everything else a job holds per shape: positions, faces, neighbours,
 /// repair maps, the Laplacian, descriptors, the regions' indicator and operator matrices,
 /// and what the allocator keeps of the parallel stages' scratch. Measured: the peak of the
-/// same 20K-vertex `match` varies from 225 to 386 MiB between runs (thread timing and
-/// the allocator's per-thread arenas); this constant keeps the estimate above every peak
-/// measured on generated humanoids of 3K-50K vertices (docs/decisions.md, "Budget").
+/// same 20K-vertex `match` varied from 224 to 532 MiB between runs (thread timing and the
+/// allocator's per-thread arenas) until `nearest_rows` reused its distance blocks; this
+/// constant keeps the estimate above every peak measured on generated humanoids of
+/// 3K-100K vertices (docs/decisions.md, "Budget").
 const SHAPE_BYTES_PER_VERTEX: u64 = 4500;
 
-/// Nonzeros of the Cholesky factor per vertex (nested dissection on surface meshes; faer's
-/// supernodal factor of 5K-100K-vertex humanoids holds 25-45 per vertex).
+/// Nonzeros of the Cholesky factor per vertex: an allowance for the fill of nested
+/// dissection on surface meshes, not measured on its own (the whole estimate is what the
+/// measured peaks were compared with).
 const FACTOR_NONZEROS_PER_VERTEX: u64 = 60;
 
 /// Queries per block of the dense nearest-neighbour search (`maps::fmap`'s `NN_BLOCK`):
@@ -102,8 +103,8 @@ const FACTOR_NONZEROS_PER_VERTEX: u64 = 60;
 const CONVERSION_BLOCK: u64 = 256;
 
 /// Multiply-adds per second and thread of the single-precision products of a conversion,
-/// measured with `p2p` at 50K vertices on a 2-core AMD EPYC (about 1.5e11 products a
-/// conversion, 48 s for three of them with the hypotheses' sample refinements).
+/// measured with `p2p` at 50K vertices on a 2-core AMD EPYC (2.5e11 products a conversion
+/// at 100 eigenpairs; 48 s for three of them with the hypotheses' sample refinements).
 const CONVERSION_PRODUCTS_PER_SECOND: f64 = 8e9;
 
 /// Seconds per vertex, eigenpair and doubling of the size for one eigensolve (shift-invert
