@@ -142,13 +142,13 @@ def reports(capfd):
 
 
 def test_the_confidence_is_reported_and_a_doubtful_answer_warned_about(addon, capfd):
-    """A six-limbed star against a quadruped: no consistent map, the answer is doubtful
-    (confidence 0.31 measured). The info report gives the confidence, a warning report the
+    """An eight-limbed star against a quadruped: no consistent map, the answer is doubtful
+    (confidence 0.003 measured). The info report gives the confidence, a warning report the
     library's sentence, the objects keep the confidence; without one-to-one matches there is
     no confidence, and the property goes away."""
     fresh_scene()
     sc = addon.shapecorr
-    shapes = [sc.Shape.figure(kind, 1, 2000) for kind in ("star6", "quadruped")]
+    shapes = [sc.Shape.figure(kind, 1, 2000) for kind in ("star8", "quadruped")]
     a = add_object("Star", shapes[0].vertices, shapes[0].triangles)
     b = add_object("Quadruped", shapes[1].vertices, shapes[1].triangles, location=(3.0, 0.0, 0.0))
     select(a, b)

@@ -87,9 +87,10 @@ def test_command_writes_coloured_files_with_region_ids(tmp_path):
 
 
 def test_a_doubtful_answer_is_reported_with_its_warning(tmp_path):
-    """A six-limbed star against a quadruped: no consistent map (confidence 0.31 measured),
-    so the command warns on stderr with the library's sentence, and still writes the files."""
-    save(figure_mesh("star6", 1, 2000), tmp_path / "a.ply")
+    """An eight-limbed star against a quadruped: no consistent map (confidence 0.003
+    measured), so the command warns on stderr with the library's sentence, and still writes
+    the files."""
+    save(figure_mesh("star8", 1, 2000), tmp_path / "a.ply")
     save(figure_mesh("quadruped", 1, 2000), tmp_path / "b.ply")
     done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "a_col.ply", "--out-b", tmp_path / "b_col.ply")
     assert done.returncode == 0, done.stderr

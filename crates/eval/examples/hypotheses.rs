@@ -1,8 +1,10 @@
 //! Which map energy tells a right region hypothesis from a wrong one (issue 18): for every
 //! pair of the datasets given, every hypothesis the default pipeline verifies, with its
 //! energies, its cost, whether it was chosen, and its full-resolution map's mean geodesic
-//! error against the ground truth (and with the flip allowed, where a mirror map exists). One JSON line
-//! per hypothesis on stdout; a summary per pair on stderr.
+//! error against the ground truth (and with the flip allowed, where a mirror map exists), and
+//! the mean distance between its full-resolution map and every other hypothesis's (`dist`,
+//! on the unit-area A). One JSON line per hypothesis on stdout; a summary per pair on
+//! stderr. `crates/eval/scripts/hypothesis_rules.py` replays selection rules on these lines.
 //!
 //!     cargo run --release -p shapecorr-eval --example hypotheses -- \
 //!         [--data DIR] [--limit N] [--cache DIR] [--reverse] DATASET ...
@@ -144,6 +146,28 @@ fn one_pair(
             )
         })
         .collect();
+    // Full-resolution mean image distance between every two hypotheses' maps (unit-area A).
+    let scale = 1.0 / basis_a.input_area.sqrt();
+    let va = a.vertices();
+    let dist: Vec<Vec<f64>> = maps
+        .iter()
+        .map(|(_, p, _)| {
+            maps.iter()
+                .map(|(_, q, _)| {
+                    p.iter()
+                        .zip(q)
+                        .map(|(&x, &y)| {
+                            let (u, v) = (va[x as usize], va[y as usize]);
+                            ((u[0] - v[0]).powi(2) + (u[1] - v[1]).powi(2) + (u[2] - v[2]).powi(2))
+                                .sqrt()
+                        })
+                        .sum::<f64>()
+                        / p.len().max(1) as f64
+                        * scale
+                })
+                .collect()
+        })
+        .collect();
     maps.push(("final".into(), map.p2p_ba.clone(), 0.0));
     let scores = score_maps(store, pair, &maps, 1000)?;
     let final_error = scores.last().map_or(f64::NAN, |s| s.error.mean);
@@ -151,7 +175,7 @@ fn one_pair(
     for (i, (h, s)) in verdict.scores.iter().zip(&scores).enumerate() {
         let e = &h.energy;
         println!(
-            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"orient_full\":{:.4},\"cover_full\":{:.4},\"seconds\":{seconds:.3}}}",
+            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"orient_full\":{:.4},\"cover_full\":{:.4},\"dist\":{:?},\"seconds\":{seconds:.3}}}",
             pair.source,
             pair.target,
             h.kind.name(),
@@ -167,6 +191,7 @@ fn one_pair(
             h.distance_to_chosen,
             extra[i].0.unwrap_or(f64::NAN),
             extra[i].1,
+            dist[i].iter().map(|d| (d * 1e4).round() / 1e4).collect::<Vec<_>>(),
         );
         summary.push_str(&format!(
             " {}{}={:.3}/{:.4}",
