@@ -643,7 +643,7 @@ pub fn choose(
 pub const SYMMETRIC_YIELDS: f64 = 1.5;
 
 /// Mean Euclidean distance between the images of the same samples under two maps.
-fn mean_image_distance(p: &[u32], q: &[u32], va: &[[f64; 3]]) -> f64 {
+pub fn mean_image_distance(p: &[u32], q: &[u32], va: &[[f64; 3]]) -> f64 {
     let sum: f64 = p
         .iter()
         .zip(q)

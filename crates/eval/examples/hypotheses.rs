@@ -153,18 +153,7 @@ fn one_pair(
         .iter()
         .map(|(_, p, _)| {
             maps.iter()
-                .map(|(_, q, _)| {
-                    p.iter()
-                        .zip(q)
-                        .map(|(&x, &y)| {
-                            let (u, v) = (va[x as usize], va[y as usize]);
-                            ((u[0] - v[0]).powi(2) + (u[1] - v[1]).powi(2) + (u[2] - v[2]).powi(2))
-                                .sqrt()
-                        })
-                        .sum::<f64>()
-                        / p.len().max(1) as f64
-                        * scale
-                })
+                .map(|(_, q, _)| shapecorr::maps::hypotheses::mean_image_distance(p, q, va) * scale)
                 .collect()
         })
         .collect();
