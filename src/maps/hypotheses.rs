@@ -3,9 +3,8 @@
 //! A one-to-one region answer can be wrong in ways the region energy cannot see: the mirror
 //! image of the truth (paper, section 5.2), or two parts of one symmetric group swapped (a
 //! quadruped's front and back legs). Instead of committing to one answer, the few best
-//! candidates ([`candidates`]: the answer, its mirror image, another rearrangement of every
-//! group, the symmetric groups with no choice made inside them, and the best single-group
-//! alternatives) are each turned into a functional map, refined by ZoomOut on vertex
+//! candidates ([`candidates`]: the answer, its mirror image, the symmetric groups with no
+//! choice made inside them, and the best single-group alternatives) are each turned into a functional map, refined by ZoomOut on vertex
 //! samples, and judged by an energy of the refined map that needs no ground truth
 //! ([`MapEnergy`]): the geodesic distortion of the sample map, the fraction of A's samples
 //! it reaches and, on orientable meshes, the fraction of B's sample triangles whose
@@ -40,10 +39,6 @@ pub enum HypothesisKind {
     /// The answer with the matching of one symmetric group (its index among the groups with
     /// a choice) replaced by another.
     Alternative(usize),
-    /// Another rearrangement of every group at once, unlike the answer and the mirror
-    /// wherever a group allows it (a quadruped's front and back legs swapped along the
-    /// whole leg); its rank among such rearrangements, from 1.
-    Rearranged(usize),
 }
 
 impl HypothesisKind {
@@ -54,7 +49,6 @@ impl HypothesisKind {
             HypothesisKind::Mirror => "mirror".into(),
             HypothesisKind::Symmetric => "symmetric".into(),
             HypothesisKind::Alternative(g) => format!("alternative {g}"),
-            HypothesisKind::Rearranged(n) => format!("rearranged {n}"),
         }
     }
 }
@@ -171,17 +165,13 @@ const OPTIONS_CAP: usize = 5040;
 /// figures measured were with two.)
 pub const MAX_ALTERNATIVES: usize = 2;
 
-/// Rearrangements of every group at once kept as hypotheses beyond the mirror
-/// ([`HypothesisKind::Rearranged`]). Only groups of three or more regions allow one: a
-/// quadruped's legs, and on some human pairs the hands and feet matched as one group
-/// (FAUST_r tr_reg_003 -> 000 and 022 -> 027 verify one: one more ZoomOut on samples).
-pub const MAX_REARRANGED: usize = 1;
-
 /// The hypotheses to verify: the answer, its mirror image (`with_mirror`, orientable meshes:
-/// on point clouds a mirror image is as right as the answer), up to [`MAX_REARRANGED`]
-/// further rearrangements of every group, the symmetric groups, and up to
-/// [`MAX_ALTERNATIVES`] single-group alternatives ranked by the distortion of region
-/// distances. Duplicates are left out.
+/// on point clouds a mirror image is as right as the answer), the symmetric groups, and up
+/// to [`MAX_ALTERNATIVES`] single-group alternatives ranked by the distortion of region
+/// distances. Duplicates are left out. (A further rearrangement of every group at once, a
+/// quadruped's front and back legs swapped, was tried at issue 18's third stop and
+/// removed at the fourth: over all 479 benchmark pairs it fixed no failure and added one;
+/// docs/decisions.md, "Rearrangements".)
 pub fn candidates(
     (a, basis_a): (&Shape, &Eigenbasis),
     (b, basis_b): (&Shape, &Eigenbasis),
@@ -214,22 +204,13 @@ pub fn candidates(
                 d_b.as_ref(),
             )
         };
-        // The mirror and the rearrangements: every group at once, each unlike those before.
-        // On point clouds the mirror is as right as the answer: it is not a hypothesis, and
-        // a rearrangement must be unlike it too.
-        let mut seen = vec![vec![None; choices.options.len()]];
-        let kinds = std::iter::once(HypothesisKind::Mirror)
-            .chain((1..=MAX_REARRANGED).map(HypothesisKind::Rearranged));
-        for kind in kinds {
-            let Some(pick) = choices.unlike(&seen, &energy) else {
-                break;
-            };
-            let groups = one_to_one_groups(&choices.assemble(&pick));
-            let wanted = with_mirror || kind != HypothesisKind::Mirror;
-            if wanted && !out.iter().any(|(_, h)| *h == groups) {
-                out.push((kind, groups));
+        // The mirror: every group at once, each unlike the answer. On point clouds it is as
+        // right as the answer, so it is not a hypothesis there.
+        if with_mirror {
+            let groups = one_to_one_groups(&choices.assemble(&choices.mirror(&energy)));
+            if !out.iter().any(|(_, h)| *h == groups) {
+                out.push((HypothesisKind::Mirror, groups));
             }
-            seen.push(pick);
         }
         let before_alternatives = out.len();
         let mut alternatives: Vec<(f64, usize, usize)> = Vec::new();
@@ -316,41 +297,22 @@ impl GroupChoices {
         pairs
     }
 
-    /// A rearrangement of every group at once, unlike each of `seen` (picks: None is the
-    /// answer's matching): every group takes a matching none of `seen` took there, where
-    /// one is left (otherwise any), chosen together to minimise `energy` by a few sweeps of
-    /// coordinate descent. With `seen` the answer alone this is its mirror image (for a
-    /// left/right pair: the swap). A region may keep its partner: a centaur's group of two
-    /// arms and a middle region mirrors by swapping the arms only. None when no group has a
-    /// matching left that `seen` did not take (pairs of regions only, as on a human).
-    fn unlike(
-        &self,
-        seen: &[Vec<Option<usize>>],
-        energy: &dyn Fn(&[Option<usize>]) -> f64,
-    ) -> Option<Vec<Option<usize>>> {
-        let all = |g: usize| std::iter::once(None).chain((0..self.options[g].len()).map(Some));
-        let fresh: Vec<Vec<Option<usize>>> = (0..self.options.len())
-            .map(|g| all(g).filter(|o| seen.iter().all(|s| s[g] != *o)).collect())
-            .collect();
-        if fresh.iter().all(Vec::is_empty) {
-            return None;
-        }
-        let allowed: Vec<Vec<Option<usize>>> = fresh
-            .into_iter()
-            .enumerate()
-            .map(|(g, f)| if f.is_empty() { all(g).collect() } else { f })
-            .collect();
-        let mut pick: Vec<Option<usize>> = allowed.iter().map(|a| a[0]).collect();
+    /// The mirror image of the answer: every group with a choice takes another matching
+    /// (for a left/right pair: the swap), chosen together to minimise `energy` by a few
+    /// sweeps of coordinate descent. A region may keep its partner: a centaur's group of
+    /// two arms and a middle region mirrors by swapping the arms only.
+    fn mirror(&self, energy: &dyn Fn(&[Option<usize>]) -> f64) -> Vec<Option<usize>> {
+        let mut pick: Vec<Option<usize>> = vec![Some(0); self.options.len()];
         for _sweep in 0..4 {
             let mut changed = false;
             for g in 0..self.options.len() {
                 let mut best = (energy(&pick), pick[g]);
-                for &o in &allowed[g] {
+                for o in 0..self.options[g].len() {
                     let mut trial = pick.clone();
-                    trial[g] = o;
+                    trial[g] = Some(o);
                     let e = energy(&trial);
                     if e < best.0 - 1e-12 {
-                        best = (e, o);
+                        best = (e, Some(o));
                     }
                 }
                 if best.1 != pick[g] {
@@ -362,7 +324,7 @@ impl GroupChoices {
                 break;
             }
         }
-        Some(pick)
+        pick
     }
 }
 
