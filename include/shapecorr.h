@@ -52,6 +52,10 @@
 // The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
 #define SC_STAGE_POINTWISE_MAP 7
 
+// Simplifying a dense shape to its proxy and bringing the answers back to every input
+// vertex (the multiresolution path, above `proxy_above` vertices).
+#define SC_STAGE_PROXY 8
+
 // Side A: the first shape given to `sc_match`.
 #define SC_SIDE_A 0
 

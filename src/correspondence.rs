@@ -14,6 +14,7 @@ use crate::budget::{regions_job, Budget, Job};
 use crate::colors::{palette, region_colors, UNMATCHED_COLOR};
 use crate::geodesic::region_distance_matrix;
 use crate::maps::hypotheses::Verdict;
+use crate::multiresolution::{lift_labels, working, Multiresolution};
 use crate::progress::{check, NoProgress, Progress, Stage};
 use crate::regions::graph::ShapeGraph;
 use crate::regions::matching::{match_graphs, MatchingParams};
@@ -54,6 +55,9 @@ pub struct Params {
     /// eigenbasis ([`crate::maps::hypotheses`]), and give the answer a confidence. Measured
     /// in docs/decisions.md (issue 18).
     pub verify_hypotheses: bool,
+    /// Dense shapes run on proxies ([`crate::multiresolution`]): above 12K vertices, proxies
+    /// of about 8K.
+    pub multiresolution: Multiresolution,
     /// The job's memory ceiling and time limit, checked from an estimate before any work
     /// and the time limit enforced while it runs ([`crate::budget`]).
     pub budget: Budget,
@@ -81,6 +85,7 @@ impl Default for Params {
             skip_one_to_one: false,
             fallback: Some(HksFallback::default()),
             verify_hypotheses: true,
+            multiresolution: Multiresolution::default(),
             budget: Budget::default(),
             non_exhaustive: crate::NonExhaustive(()),
         }
@@ -96,6 +101,7 @@ impl Params {
         self.hks.validate()?;
         self.segmentation.validate()?;
         self.matching.validate()?;
+        self.multiresolution.validate()?;
         if let Some(fallback) = &self.fallback {
             if !(fallback.hks_t_min > 0.0 && fallback.hks_t_min <= self.hks.t_max) {
                 return Err(crate::Error::InvalidParameter {
@@ -133,6 +139,9 @@ pub struct Timings {
     pub matching: f64,
     /// Symmetry breaking into the one-to-one matches, their verification included.
     pub one_to_one: f64,
+    /// Building the proxies of dense shapes and bringing the answers back to every input
+    /// vertex (0 when both shapes ran at full resolution, [`Params::multiresolution`]).
+    pub proxies: f64,
     /// Whole call, from [`Correspondence::compute`] or [`Correspondence::from_bases`].
     pub total: f64,
 }
@@ -170,14 +179,32 @@ impl Correspondence {
         params.validate()?;
         params.budget.check(&Correspondence::job(a, b, params))?;
         params.budget.run(progress, |progress| {
-            Correspondence::compute_within(a, b, params, progress)
+            let started = Instant::now();
+            let proxies = params
+                .multiresolution
+                .proxies([a, b], &params.eigen, progress)?;
+            let built = started.elapsed().as_secs_f64();
+            let [proxy_a, proxy_b] = &proxies;
+            let working = (working(a, proxy_a), working(b, proxy_b));
+            let mut result =
+                Correspondence::compute_within(working.0, working.1, params, progress)?;
+            let t = Instant::now();
+            result.graph_a.labels =
+                lift_labels(std::mem::take(&mut result.graph_a.labels), proxy_a);
+            result.graph_b.labels =
+                lift_labels(std::mem::take(&mut result.graph_b.labels), proxy_b);
+            if proxy_a.is_some() || proxy_b.is_some() {
+                result.timings.proxies = built + t.elapsed().as_secs_f64();
+            }
+            result.timings.total = started.elapsed().as_secs_f64();
+            Ok(result)
         })
     }
 
     /// What [`Correspondence::compute`] will do on these shapes, for [`Budget::check`].
     pub fn job(a: &Shape, b: &Shape, params: &Params) -> Job {
         let verify = params.verify_hypotheses && !params.skip_one_to_one;
-        let sizes = [a, b].map(|s| s.active_vertices().len());
+        let sizes = [a, b].map(|s| params.multiresolution.working_size(s));
         regions_job(sizes, &params.eigen, verify)
     }
 

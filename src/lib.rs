@@ -55,6 +55,7 @@ pub mod evaluation;
 pub mod ffi;
 pub mod geodesic;
 pub mod maps;
+pub mod multiresolution;
 pub mod options;
 pub mod progress;
 pub mod regions;

@@ -350,6 +350,18 @@ pub const OPTIONS: &[OptionInfo] = &[
     )
     .range(0.0, 1.0),
     info(
+        "proxy_above",
+        Int,
+        "dense shapes: a shape with more vertices runs on a proxy of about proxy_vertices (0: never)",
+    )
+    .range(0.0, 100_000_000.0),
+    info(
+        "proxy_vertices",
+        Int,
+        "dense shapes: about how many vertices a proxy has (64 or more, below proxy_above)",
+    )
+    .range(64.0, 100_000_000.0),
+    info(
         "max_vertices",
         Int,
         "largest shape accepted, in vertices; a larger one is refused before any work",
@@ -563,6 +575,8 @@ impl Params {
                     "exhaustive_limit" => self.symmetry.exhaustive_limit = v,
                     "symmetry_restarts" => self.symmetry.restarts = v,
                     "max_vertices" => self.eigen.max_vertices = v,
+                    "proxy_above" => self.multiresolution.above = v,
+                    "proxy_vertices" => self.multiresolution.proxy_vertices = v,
                     "memory_limit_mib" => self.budget.memory_limit_mib = v as u64,
                     other => unreachable!("integer option {other} has no field"),
                 }
@@ -620,6 +634,8 @@ impl Params {
             "hks_fallback" => OptionValue::Bool(self.fallback.is_some()),
             "verify_hypotheses" => OptionValue::Bool(self.verify_hypotheses),
             "max_vertices" => int(self.eigen.max_vertices),
+            "proxy_above" => int(self.multiresolution.above),
+            "proxy_vertices" => int(self.multiresolution.proxy_vertices),
             "memory_limit_mib" => int(self.budget.memory_limit_mib as usize),
             "time_limit_s" => OptionValue::Float(self.budget.time_limit_s),
             other => unreachable!("option {other} has no field"),

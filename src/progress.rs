@@ -19,6 +19,9 @@ pub enum Stage {
     SymmetryBreaking = 6,
     /// Point-to-point map (functional map and its refinement).
     PointwiseMap = 7,
+    /// Simplifying a dense shape to its proxy and bringing the answers back to every input
+    /// vertex (the multiresolution path, [`crate::multiresolution`]).
+    Proxy = 8,
 }
 
 /// Receives progress and may cancel: `report` returns `false` to stop the work, which then

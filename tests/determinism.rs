@@ -24,6 +24,25 @@ fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .install(f)
 }
 
+/// The pointwise correspondence computed in a pool of `threads` threads.
+fn pointwise_on(
+    threads: usize,
+    a: &Shape,
+    b: &Shape,
+    options: &Options,
+) -> PointwiseCorrespondence {
+    in_pool(threads, || {
+        PointwiseCorrespondence::compute(
+            a,
+            b,
+            &options.params,
+            options.pointwise(),
+            &mut NoProgress,
+        )
+        .unwrap()
+    })
+}
+
 fn bits(values: impl IntoIterator<Item = f64>) -> Vec<u64> {
     values.into_iter().map(f64::to_bits).collect()
 }
@@ -59,19 +78,10 @@ fn eigenbasis_and_hks_are_bit_identical_for_one_and_two_threads() {
 fn pointwise_result_graphs_are_bit_identical_for_one_and_two_threads() {
     let (a, b) = (humanoid(0), humanoid(3));
     let options = Options::default();
-    let run = |threads| {
-        in_pool(threads, || {
-            PointwiseCorrespondence::compute(
-                &a,
-                &b,
-                &options.params,
-                options.pointwise(),
-                &mut NoProgress,
-            )
-            .unwrap()
-        })
-    };
-    let (one, two) = (run(1), run(2));
+    let (one, two) = (
+        pointwise_on(1, &a, &b, &options),
+        pointwise_on(2, &a, &b, &options),
+    );
     assert_eq!(one.map.p2p_ba, two.map.p2p_ba);
     for (g1, g2) in [
         (&one.regions.graph_a, &two.regions.graph_a),
@@ -89,4 +99,30 @@ fn pointwise_result_graphs_are_bit_identical_for_one_and_two_threads() {
         };
         assert!(flat(g1) == flat(g2), "graph descriptors differ");
     }
+}
+
+#[test]
+fn the_multiresolution_path_is_identical_for_one_and_two_threads() {
+    let dense = |pose| {
+        let mesh = synth::figure(&FigureSpec {
+            kind: FigureKind::Humanoid,
+            pose,
+            target_vertices: 8000,
+            ..Default::default()
+        })
+        .unwrap();
+        Shape::mesh(mesh.vertices, &mesh.triangles).unwrap()
+    };
+    let (a, b) = (dense(0), dense(3));
+    let mut options = Options::default();
+    options.params.multiresolution.above = 4000;
+    options.params.multiresolution.proxy_vertices = 2000;
+    let (one, two) = (
+        pointwise_on(1, &a, &b, &options),
+        pointwise_on(2, &a, &b, &options),
+    );
+    assert!(one.proxies > 0.0, "the proxies were not used");
+    assert_eq!(one.map.p2p_ba, two.map.p2p_ba);
+    assert_eq!(one.regions.graph_a.labels, two.regions.graph_a.labels);
+    assert_eq!(one.regions.graph_b.labels, two.regions.graph_b.labels);
 }

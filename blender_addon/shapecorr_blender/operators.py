@@ -23,7 +23,7 @@ REGION_ATTRIBUTE = "shapecorr_region"
 CONFIDENCE_PROPERTY = "shapecorr_confidence"
 
 #: Pipeline stages as reported by the library, in order (for one overall progress value).
-_STAGES = ["laplacian", "eigenbasis", "descriptors", "segmentation", "matching", "symmetry_breaking"]
+_STAGES = ["proxy", "laplacian", "eigenbasis", "descriptors", "segmentation", "matching", "symmetry_breaking"]
 
 
 def selection_problem(context, wanted):

@@ -58,6 +58,9 @@ pub const SC_STAGE_MATCHING: u32 = 5;
 pub const SC_STAGE_SYMMETRY_BREAKING: u32 = 6;
 /// The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
 pub const SC_STAGE_POINTWISE_MAP: u32 = 7;
+/// Simplifying a dense shape to its proxy and bringing the answers back to every input
+/// vertex (the multiresolution path, above `proxy_above` vertices).
+pub const SC_STAGE_PROXY: u32 = 8;
 
 /// Progress callback: called on the calling thread with a stage (`SC_STAGE_*`) and the
 /// fraction of that stage done (0 to 1). Return `false` to cancel: the call then returns
@@ -136,6 +139,7 @@ mod tests {
         assert_eq!(SC_STAGE_MATCHING, Stage::Matching as u32);
         assert_eq!(SC_STAGE_SYMMETRY_BREAKING, Stage::SymmetryBreaking as u32);
         assert_eq!(SC_STAGE_POINTWISE_MAP, Stage::PointwiseMap as u32);
+        assert_eq!(SC_STAGE_PROXY, Stage::Proxy as u32);
     }
 
     /// The handles' thread-safety promises in the header rest on these.

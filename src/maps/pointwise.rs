@@ -19,6 +19,7 @@ use crate::maps::fmap::{
 };
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, HypothesisKind, RegionGroups, Verdict};
+use crate::multiresolution::{lift_labels, lift_map, working};
 use crate::progress::{check, polled, Cancel, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
@@ -706,6 +707,9 @@ pub struct PointwiseCorrespondence {
     pub eigenbasis_a: f64,
     /// Seconds of B's eigenbasis.
     pub eigenbasis_b: f64,
+    /// Seconds of building the proxies of dense shapes and bringing the regions and the map
+    /// back to every input vertex (0 at full resolution, [`Params::multiresolution`]).
+    pub proxies: f64,
     /// Seconds of the whole call.
     pub total: f64,
 }
@@ -742,7 +746,31 @@ impl PointwiseCorrespondence {
             .budget
             .check(&PointwiseCorrespondence::job(a, b, params, pointwise))?;
         params.budget.run(progress, |progress| {
-            PointwiseCorrespondence::compute_within((a, b), &eigen, params, pointwise, progress)
+            let started = Instant::now();
+            let proxies = params.multiresolution.proxies([a, b], &eigen, progress)?;
+            let built = started.elapsed().as_secs_f64();
+            let [proxy_a, proxy_b] = &proxies;
+            let (working_a, working_b) = (working(a, proxy_a), working(b, proxy_b));
+            let mut result = PointwiseCorrespondence::compute_within(
+                (working_a, working_b),
+                &eigen,
+                params,
+                pointwise,
+                progress,
+            )?;
+            let t = Instant::now();
+            let regions = &mut result.regions;
+            regions.graph_a.labels =
+                lift_labels(std::mem::take(&mut regions.graph_a.labels), proxy_a);
+            regions.graph_b.labels =
+                lift_labels(std::mem::take(&mut regions.graph_b.labels), proxy_b);
+            result.map.p2p_ba = lift_map((a, proxy_a), (b, proxy_b), &result.map.p2p_ba, progress)?;
+            if proxy_a.is_some() || proxy_b.is_some() {
+                result.proxies = built + t.elapsed().as_secs_f64();
+            }
+            result.regions.timings.proxies = result.proxies;
+            result.total = started.elapsed().as_secs_f64();
+            Ok(result)
         })
     }
 
@@ -760,7 +788,7 @@ impl PointwiseCorrespondence {
             Refinement::ZoomOut(z) => z.k_end,
             _ => pointwise.fmap_size,
         };
-        let sizes = [a, b].map(|s| s.active_vertices().len());
+        let sizes = [a, b].map(|s| params.multiresolution.working_size(s));
         crate::budget::Job {
             conversions: if params.verify_hypotheses { 3 } else { 1 },
             conversion_size: size.min(eigen.n_eigenpairs),
@@ -791,6 +819,7 @@ impl PointwiseCorrespondence {
             map,
             eigenbasis_a,
             eigenbasis_b,
+            proxies: 0.0,
             total: started.elapsed().as_secs_f64(),
         })
     }

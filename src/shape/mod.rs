@@ -9,6 +9,7 @@
 
 pub mod io;
 pub mod neighbors;
+pub mod proxy;
 pub mod repair;
 
 use std::collections::HashMap;

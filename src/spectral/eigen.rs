@@ -201,6 +201,13 @@ fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
             ),
         });
     }
+    check_max_vertices(shape, params)
+}
+
+/// Refuses a shape above [`EigenParams::max_vertices`] (also checked on a dense input before
+/// its proxy is built, [`crate::multiresolution`]).
+pub(crate) fn check_max_vertices(shape: &Shape, params: &EigenParams) -> Result<()> {
+    let n = shape.active_vertices().len();
     if n > params.max_vertices {
         return Err(Error::InvalidParameter {
             name: "max_vertices",

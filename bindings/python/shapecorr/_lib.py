@@ -276,4 +276,5 @@ STAGE_NAMES = {
     5: "matching",
     6: "symmetry_breaking",
     7: "pointwise_map",
+    8: "proxy",
 }

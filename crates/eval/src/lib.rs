@@ -9,7 +9,8 @@
 //! [`bench_clouds`] the point-cloud protocol; [`reeb`] is the Reeb-graph baseline;
 //! [`bench_store`] caches eigenbases and keeps resumable logs; [`bench_all`] runs every table
 //! and writes `docs/results.md`; [`plot`] draws the PNG figures; [`bench_tails`] runs every pair of every dataset for
-//! `docs/tails.md`; [`tails`] summarises every
+//! `docs/tails.md`; [`bench_scale`] measures time and memory against size (`docs/scale.md`);
+//! [`tails`] summarises every
 //! score by its mean, median, worst pair and count of failed pairs.
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -18,6 +19,7 @@ pub mod bench;
 pub mod bench_all;
 pub mod bench_clouds;
 pub mod bench_pointwise;
+pub mod bench_scale;
 pub mod bench_store;
 pub mod bench_tails;
 pub mod datasets;

@@ -35,6 +35,11 @@ pub enum BenchCommand {
     /// accuracies, and how well the confidence flags the failed pairs. Writes OUT (default
     /// docs/tails.md); resumable from WORK/tails.jsonl, eigenbases kept in WORK/eigenbases.
     Tails(BenchTailsArgs),
+    /// Time, peak memory and accuracy of `match` and `p2p` against size, on generated pairs
+    /// from 5K to 1M vertices, with the full-resolution path and pyFM as references. Writes
+    /// OUT (default docs/scale.md) and a log-log PNG beside it; resumable from
+    /// WORK/scale.jsonl.
+    Scale(BenchScaleArgs),
 }
 
 impl BenchCommand {
@@ -45,6 +50,7 @@ impl BenchCommand {
             BenchCommand::All(args) => args.run(),
             BenchCommand::Maps(args) => args.run(),
             BenchCommand::Tails(args) => args.run(),
+            BenchCommand::Scale(args) => args.run(),
         }
     }
 }
@@ -403,6 +409,10 @@ pub struct BenchTailsArgs {
     /// Ground-truth pairs scored per shape pair (a seeded sample; 0 = all).
     #[arg(long, default_value_t = 1000)]
     samples: usize,
+    /// Every shape at full resolution (no proxies for dense shapes: the reference the
+    /// multiresolution path is compared with).
+    #[arg(long)]
+    full_resolution: bool,
 }
 
 impl BenchTailsArgs {
@@ -412,12 +422,76 @@ impl BenchTailsArgs {
             &self.work,
             self.datasets.as_deref(),
             self.samples,
+            self.full_resolution,
         )?;
         let mut command = "shapecorr bench tails".to_string();
+        if self.full_resolution {
+            command.push_str(" --full-resolution");
+        }
         if let Some(d) = &self.datasets {
             command.push_str(&format!(" --datasets {}", d.join(",")));
         }
         let page = shapecorr_eval::bench_tails::tails_page(&records, &command);
+        std::fs::write(&self.out, &page).map_err(|e| Error::file(&self.out, e.to_string()))?;
+        print!("{page}");
+        Ok(())
+    }
+}
+
+#[derive(clap::Args)]
+pub struct BenchScaleArgs {
+    /// Vertices per shape (comma separated).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "5000,12000,25000,50000,100000,250000,500000,1000000"
+    )]
+    sizes: Vec<usize>,
+    /// The page to write (the PNG goes beside it, same name).
+    #[arg(long, default_value = "docs/scale.md")]
+    out: PathBuf,
+    /// Generated pairs, outputs and the log.
+    #[arg(long, default_value = "target/bench-scale")]
+    work: PathBuf,
+    /// Run the full-resolution path too up to this many vertices.
+    #[arg(long, default_value_t = 100_000)]
+    full_up_to: usize,
+    /// A Python with pyFM (pyfmaps) installed, for the reference
+    /// (tests/bench/scale_pyfm.sh makes one); none: no pyFM column.
+    #[arg(long)]
+    pyfm_python: Option<PathBuf>,
+    /// pyFM runs at the next size only while it finished within this many seconds.
+    #[arg(long, default_value_t = 600)]
+    pyfm_limit_s: u64,
+}
+
+impl BenchScaleArgs {
+    pub fn run(&self) -> Result<(), Error> {
+        let exe = std::env::current_exe()
+            .map_err(|e| Error::file(Path::new("shapecorr"), e.to_string()))?;
+        let settings = shapecorr_eval::bench_scale::ScaleSettings {
+            sizes: self.sizes.clone(),
+            exe,
+            work: self.work.clone(),
+            full_up_to: self.full_up_to,
+            pyfm_python: self.pyfm_python.clone(),
+            pyfm_script: PathBuf::from("tests/bench/scale_pyfm.py"),
+            pyfm_limit: std::time::Duration::from_secs(self.pyfm_limit_s),
+        };
+        let records = shapecorr_eval::bench_scale::run_scale(&settings)?;
+        let sizes: Vec<String> = self.sizes.iter().map(|n| n.to_string()).collect();
+        let command = format!(
+            "shapecorr bench scale --sizes {} --full-up-to {}{}",
+            sizes.join(","),
+            self.full_up_to,
+            if self.pyfm_python.is_some() {
+                " --pyfm-python PY"
+            } else {
+                ""
+            }
+        );
+        let png = self.out.with_extension("png");
+        let page = shapecorr_eval::bench_scale::scale_page(&records, &command, &png)?;
         std::fs::write(&self.out, &page).map_err(|e| Error::file(&self.out, e.to_string()))?;
         print!("{page}");
         Ok(())

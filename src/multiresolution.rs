@@ -1,0 +1,232 @@
+//! The multiresolution path for dense shapes (issue 20; docs/design.md, step 16).
+//!
+//! Above [`Multiresolution::above`] active vertices a shape is replaced by a proxy of about
+//! [`Multiresolution::proxy_vertices`] vertices ([`Proxy`]); the whole pipeline runs on the
+//! proxies and its answers come back to every input vertex:
+//! - regions: every input vertex takes the region of its nearest proxy vertex on the proxy
+//!   surface ([`Proxy::lift_nearest`]);
+//! - the map: every input vertex of B is located on B's proxy, its three proxy vertices are
+//!   mapped to A's proxy, and where their images lie close together the point they span
+//!   with the same weights is taken to its nearest input vertex of A (a 3D k-d tree); where
+//!   they do not (the map tears there), the image of the heaviest is kept ([`lift_map`]).
+//!
+//! Nothing compares full-resolution vertex sets pairwise: building a proxy and lifting are
+//! O(n log n) in the input's vertices, the rest runs on the proxies.
+
+use rayon::prelude::*;
+
+use crate::progress::{polled, Cancel, Progress, Stage};
+use crate::shape::neighbors::PointTree;
+use crate::shape::proxy::Proxy;
+use crate::shape::Shape;
+use crate::spectral::eigen::{check_max_vertices, EigenParams};
+use crate::Result;
+
+/// When the pipeline runs on proxies, and how large they are.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Multiresolution {
+    /// A shape with more active vertices than this gets a proxy (0: never).
+    pub above: usize,
+    /// About how many vertices a proxy has.
+    pub proxy_vertices: usize,
+}
+
+/// Default [`Multiresolution::above`]: 1.5 times the proxy's size (below it a proxy would
+/// save less than a third of the vertices). FAUST (6.9K), FAUST_r, TOSCA_r and the camel
+/// gallop (5K) run at full resolution; TOSCA (15.8K-52.6K) and anything denser on proxies.
+pub const DEFAULT_PROXY_ABOVE: usize = 12_000;
+
+/// Default [`Multiresolution::proxy_vertices`]: about the resolution of FAUST (6.9K), where
+/// the full-resolution pipeline was measured (docs/results.md).
+pub const DEFAULT_PROXY_VERTICES: usize = 8_000;
+
+impl Default for Multiresolution {
+    fn default() -> Self {
+        Multiresolution {
+            above: DEFAULT_PROXY_ABOVE,
+            proxy_vertices: DEFAULT_PROXY_VERTICES,
+        }
+    }
+}
+
+impl Multiresolution {
+    /// Checks the sizes: a proxy needs at least 64 vertices and fewer than `above`.
+    pub fn validate(&self) -> Result<()> {
+        if self.above != 0 && (self.proxy_vertices < 64 || self.proxy_vertices >= self.above) {
+            return Err(crate::Error::InvalidParameter {
+                name: "proxy_vertices",
+                reason: format!(
+                    "need 64 <= proxy_vertices < proxy_above = {}, got {}",
+                    self.above, self.proxy_vertices
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// The vertices `shape` is computed on: its proxy's size, or its own.
+    pub fn working_size(&self, shape: &Shape) -> usize {
+        let n = shape.active_vertices().len();
+        if self.applies_to(shape) {
+            n.min(self.proxy_vertices)
+        } else {
+            n
+        }
+    }
+
+    /// Whether `shape` gets a proxy.
+    pub fn applies_to(&self, shape: &Shape) -> bool {
+        self.above != 0 && shape.active_vertices().len() > self.above
+    }
+
+    /// The proxies of the shapes that need one (None for a shape that runs as it is).
+    pub(crate) fn proxies(
+        &self,
+        [a, b]: [&Shape; 2],
+        eigen: &EigenParams,
+        progress: &mut dyn Progress,
+    ) -> Result<[Option<Proxy>; 2]> {
+        check_max_vertices(a, eigen).map_err(|e| e.in_shape('A'))?;
+        check_max_vertices(b, eigen).map_err(|e| e.in_shape('B'))?;
+        if !self.applies_to(a) && !self.applies_to(b) {
+            return Ok([None, None]);
+        }
+        polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
+            let build = |shape: &Shape| -> Result<Option<Proxy>> {
+                cancel.check()?;
+                if self.applies_to(shape) {
+                    Proxy::build(shape, self.proxy_vertices).map(Some)
+                } else {
+                    Ok(None)
+                }
+            };
+            let proxy_a = build(a).map_err(|e| e.in_shape('A'))?;
+            cancel.set_fraction(0.5);
+            let proxy_b = build(b).map_err(|e| e.in_shape('B'))?;
+            Ok([proxy_a, proxy_b])
+        })
+    }
+}
+
+/// The shape the pipeline runs on: the proxy's, or the shape itself.
+pub(crate) fn working<'a>(shape: &'a Shape, proxy: &'a Option<Proxy>) -> &'a Shape {
+    proxy.as_ref().map_or(shape, |p| &p.shape)
+}
+
+/// Region labels of the working shape brought back to every input vertex.
+pub(crate) fn lift_labels(labels: Vec<u32>, proxy: &Option<Proxy>) -> Vec<u32> {
+    match proxy {
+        Some(proxy) => proxy.lift_nearest(&labels),
+        None => labels,
+    }
+}
+
+/// Input vertices per block between cancel checks in [`lift_map`].
+const LIFT_BLOCK: usize = 16_384;
+
+/// Images further apart than this many mean proxy edges of A are not interpolated (the map
+/// tears between them): the heaviest one's is kept.
+const TEAR_EDGES: f64 = 3.0;
+
+/// The map from B's working shape to A's (`p2p_ba`, one A vertex of the working shape per B
+/// vertex of the working shape) brought to every input vertex of B, as input vertices of
+/// A. See the module docs.
+pub(crate) fn lift_map(
+    (a, proxy_a): (&Shape, &Option<Proxy>),
+    (b, proxy_b): (&Shape, &Option<Proxy>),
+    p2p_ba: &[u32],
+    progress: &mut dyn Progress,
+) -> Result<Vec<u32>> {
+    if proxy_a.is_none() && proxy_b.is_none() {
+        return Ok(p2p_ba.to_vec());
+    }
+    polled(progress, Stage::Proxy, (0.5, 1.0), |cancel| {
+        lift_map_cancellable((a, proxy_a), (b, proxy_b), p2p_ba, cancel)
+    })
+}
+
+fn lift_map_cancellable(
+    (a, proxy_a): (&Shape, &Option<Proxy>),
+    (b, proxy_b): (&Shape, &Option<Proxy>),
+    p2p_ba: &[u32],
+    cancel: &Cancel,
+) -> Result<Vec<u32>> {
+    let working_a = working(a, proxy_a);
+    // A proxy vertex of A as an input vertex of A.
+    let input_a = |v: u32| proxy_a.as_ref().map_or(v, |p| p.input_vertex[v as usize]);
+    let active_a = a.active_vertices();
+    let tree = PointTree::new(
+        &active_a
+            .iter()
+            .map(|&v| a.vertices()[v as usize])
+            .collect::<Vec<_>>(),
+    );
+    let tear = TEAR_EDGES * mean_edge_length(working_a);
+    let n_b = b.n_vertices();
+    let mut out = Vec::with_capacity(n_b);
+    for start in (0..n_b).step_by(LIFT_BLOCK) {
+        cancel.check()?;
+        cancel.set_fraction(start as f32 / n_b as f32);
+        let end = (start + LIFT_BLOCK).min(n_b);
+        let block: Vec<u32> = (start..end)
+            .into_par_iter()
+            .map(|v| {
+                let Some(proxy_b) = proxy_b else {
+                    return input_a(p2p_ba[v]);
+                };
+                let at = proxy_b.location[v];
+                let images = at.vertices.map(|w| input_a(p2p_ba[w as usize]));
+                if at.weights[1] <= 0.0 {
+                    return images[0];
+                }
+                let points = images.map(|i| a.vertices()[i as usize]);
+                let spread = (0..3)
+                    .flat_map(|i| (i + 1..3).map(move |j| (i, j)))
+                    .filter(|&(i, j)| at.weights[i] > 0.0 && at.weights[j] > 0.0)
+                    .map(|(i, j)| distance(&points[i], &points[j]))
+                    .fold(0.0, f64::max);
+                if spread > tear {
+                    return images[0];
+                }
+                let point =
+                    [0, 1, 2].map(|c| (0..3).map(|i| at.weights[i] * points[i][c]).sum::<f64>());
+                active_a[tree.nearest(&point)]
+            })
+            .collect();
+        out.extend(block);
+    }
+    Ok(out)
+}
+
+fn distance(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+}
+
+/// Mean edge length of a mesh; for a point cloud, the mean distance to the nearest other
+/// point.
+fn mean_edge_length(shape: &Shape) -> f64 {
+    let p = shape.vertices();
+    let edges = shape.edges();
+    if !edges.is_empty() {
+        return edges
+            .iter()
+            .map(|&(i, j)| distance(&p[i as usize], &p[j as usize]))
+            .sum::<f64>()
+            / edges.len() as f64;
+    }
+    let active: Vec<[f64; 3]> = shape
+        .active_vertices()
+        .iter()
+        .map(|&v| p[v as usize])
+        .collect();
+    let tree = PointTree::new(&active);
+    active
+        .iter()
+        .map(|q| {
+            tree.nearest_k(q, 2)
+                .last()
+                .map_or(0.0, |&(_, d2)| d2.sqrt())
+        })
+        .sum::<f64>()
+        / active.len() as f64
+}
