@@ -14,7 +14,7 @@ use crate::budget::{regions_job, Budget, Job};
 use crate::colors::{palette, region_colors, UNMATCHED_COLOR};
 use crate::geodesic::region_distance_matrix;
 use crate::maps::hypotheses::Verdict;
-use crate::multiresolution::{lift_labels, working, Multiresolution};
+use crate::multiresolution::{lift_regions, working, Multiresolution};
 use crate::progress::{check, NoProgress, Progress, Stage};
 use crate::regions::graph::ShapeGraph;
 use crate::regions::matching::{match_graphs, MatchingParams};
@@ -189,10 +189,7 @@ impl Correspondence {
             let mut result =
                 Correspondence::compute_within(working.0, working.1, params, progress)?;
             let t = Instant::now();
-            result.graph_a.labels =
-                lift_labels(std::mem::take(&mut result.graph_a.labels), proxy_a);
-            result.graph_b.labels =
-                lift_labels(std::mem::take(&mut result.graph_b.labels), proxy_b);
+            lift_regions(&mut result, &proxies);
             if proxy_a.is_some() || proxy_b.is_some() {
                 result.timings.proxies = built + t.elapsed().as_secs_f64();
             }

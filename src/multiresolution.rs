@@ -15,6 +15,7 @@
 
 use rayon::prelude::*;
 
+use crate::correspondence::Correspondence;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::neighbors::PointTree;
 use crate::shape::proxy::Proxy;
@@ -113,11 +114,15 @@ pub(crate) fn working<'a>(shape: &'a Shape, proxy: &'a Option<Proxy>) -> &'a Sha
     proxy.as_ref().map_or(shape, |p| &p.shape)
 }
 
-/// Region labels of the working shape brought back to every input vertex.
-pub(crate) fn lift_labels(labels: Vec<u32>, proxy: &Option<Proxy>) -> Vec<u32> {
-    match proxy {
-        Some(proxy) => proxy.lift_nearest(&labels),
-        None => labels,
+/// The regions' labels of the working shapes brought back to every input vertex.
+pub(crate) fn lift_regions(regions: &mut Correspondence, [proxy_a, proxy_b]: &[Option<Proxy>; 2]) {
+    for (graph, proxy) in [
+        (&mut regions.graph_a, proxy_a),
+        (&mut regions.graph_b, proxy_b),
+    ] {
+        if let Some(proxy) = proxy {
+            graph.labels = proxy.lift_nearest(&graph.labels);
+        }
     }
 }
 

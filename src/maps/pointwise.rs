@@ -19,7 +19,7 @@ use crate::maps::fmap::{
 };
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, HypothesisKind, RegionGroups, Verdict};
-use crate::multiresolution::{lift_labels, lift_map, working};
+use crate::multiresolution::{lift_map, lift_regions, working};
 use crate::progress::{check, polled, Cancel, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
@@ -759,11 +759,7 @@ impl PointwiseCorrespondence {
                 progress,
             )?;
             let t = Instant::now();
-            let regions = &mut result.regions;
-            regions.graph_a.labels =
-                lift_labels(std::mem::take(&mut regions.graph_a.labels), proxy_a);
-            regions.graph_b.labels =
-                lift_labels(std::mem::take(&mut regions.graph_b.labels), proxy_b);
+            lift_regions(&mut result.regions, &proxies);
             result.map.p2p_ba = lift_map((a, proxy_a), (b, proxy_b), &result.map.p2p_ba, progress)?;
             if proxy_a.is_some() || proxy_b.is_some() {
                 result.proxies = built + t.elapsed().as_secs_f64();

@@ -636,7 +636,9 @@ fn page_header(s: &mut String, p: &AllParams, all: &[DatasetResults], wall: f64)
         "Made by one command: `{}`{}. Everything on this page was measured by that command \
          (an interrupted run resumes from its logs; the timing table is measured without the \
          eigenbasis cache). Every pair of every list, judged by its tails (median, worst pair, \
-         failed pairs, the confidence's flags), is in [tails.md](tails.md) (`shapecorr bench tails`).\n",
+         failed pairs, the confidence's flags), is in [tails.md](tails.md) (`shapecorr bench tails`); \
+         time, memory and accuracy against size, 5K to 1M vertices, with pyFM beside, in \
+         [scale.md](scale.md) (`shapecorr bench scale`).\n",
         p.command,
         if p.quick {
             " on generated humanoid figures only (CI's quick mode: the figures say nothing about the benchmarks)"

@@ -43,6 +43,9 @@ pub struct ScaleRecord {
     pub stages: serde_json::Value,
     /// Mean geodesic error of the map on A over sqrt(area) (p2p and pyFM only).
     pub error: Option<f64>,
+    /// The answer's confidence as the tool reports it (ours only; below 0.45: doubtful).
+    #[serde(default)]
+    pub confidence: Option<f64>,
     /// Why there is no figure (a time-out, a failure).
     pub note: Option<String>,
 }
@@ -192,6 +195,7 @@ fn run_one(
         peak_mib: None,
         stages: serde_json::Value::Null,
         error: None,
+        confidence: None,
         note: None,
     };
     let mut process = if command == "pyfm" {
@@ -256,6 +260,7 @@ fn run_one(
             .as_f64()
             .or(json["peak_memory_mib"].as_f64());
         record.stages = json["timings_s"].clone();
+        record.confidence = json["confidence"].as_f64();
     }
     if command.starts_with("p2p") || command == "pyfm" {
         let map_path = out.join("map_b_to_a.txt");
@@ -359,6 +364,19 @@ impl Ord for Ordered {
     }
 }
 
+/// The processor's model name (Linux), or "unknown processor".
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown processor".into())
+}
+
 /// Slope of log(seconds) against log(vertices) by least squares over the sizes from `from`.
 pub fn log_log_slope(points: &[(usize, f64)], from: usize) -> Option<f64> {
     let pts: Vec<(f64, f64)> = points
@@ -389,9 +407,12 @@ pub fn scale_page(records: &[ScaleRecord], command: &str, png: &Path) -> Result<
         match get(n, c) {
             Some(r) => match (r.seconds, &r.note) {
                 (Some(s), _) => format!(
-                    "{s:.2} s, {} MiB{}",
+                    "{s:.2} s, {} MiB{}{}",
                     fmt(r.peak_mib, 0),
-                    r.error.map_or(String::new(), |e| format!(", error {e:.4}"))
+                    r.error.map_or(String::new(), |e| format!(", error {e:.4}")),
+                    r.confidence
+                        .filter(|&c| c < shapecorr::maps::hypotheses::DOUBTFUL_BELOW)
+                        .map_or(String::new(), |c| format!(" (doubtful: confidence {c:.2})"))
                 ),
                 (None, Some(note)) => note.clone(),
                 (None, None) => "-".into(),
@@ -402,7 +423,7 @@ pub fn scale_page(records: &[ScaleRecord], command: &str, png: &Path) -> Result<
     let mut s = String::new();
     s.push_str("# Dense meshes: time, memory and accuracy against size\n\n");
     s.push_str(&format!(
-        "Made by `{command}` on {} ({} cores). Generated humanoid pairs (pose 0 -> pose 3, \
+        "Made by `{command}` on {} ({} cores, {}). Generated humanoid pairs (pose 0 -> pose 3, \
          limb thickness 1.2; above 200K vertices the figure split 1:4 at edge midpoints); \
          each command a fresh process of the tool, wall time with file reading and writing, \
          peak resident memory of that process. `match` and `p2p` run as shipped (proxies of \
@@ -411,7 +432,8 @@ pub fn scale_page(records: &[ScaleRecord], command: &str, png: &Path) -> Result<
          geodesic error (edge graph) of 500 seeded vertices over sqrt(area); the truth is \
          exact at every size.\n\n",
         std::env::consts::ARCH,
-        std::thread::available_parallelism().map_or(0, |n| n.get())
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        cpu_model()
     ));
     s.push_str(
         "| vertices | match | p2p | match full | p2p full | pyFM |\n|---|---|---|---|---|---|\n",
