@@ -130,7 +130,8 @@ pub(crate) fn lift_regions(regions: &mut Correspondence, [proxy_a, proxy_b]: &[O
 const LIFT_BLOCK: usize = 16_384;
 
 /// Images further apart than this many mean proxy edges of A are not interpolated (the map
-/// tears between them): the heaviest one's is kept.
+/// tears between them): the heaviest one's is kept. Not tuned: three edges is a triangle's
+/// images spread over about one ring of A's proxy.
 const TEAR_EDGES: f64 = 3.0;
 
 /// The map from B's working shape to A's (`p2p_ba`, one A vertex of the working shape per B
