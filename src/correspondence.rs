@@ -185,9 +185,9 @@ impl Correspondence {
                 .proxies([a, b], &params.eigen, progress)?;
             let built = started.elapsed().as_secs_f64();
             let [proxy_a, proxy_b] = &proxies;
-            let working = (working(a, proxy_a), working(b, proxy_b));
+            let (working_a, working_b) = (working(a, proxy_a), working(b, proxy_b));
             let mut result =
-                Correspondence::compute_within(working.0, working.1, params, progress)?;
+                Correspondence::compute_within(working_a, working_b, params, progress)?;
             let t = Instant::now();
             lift_regions(&mut result, &proxies);
             if proxy_a.is_some() || proxy_b.is_some() {

@@ -4,9 +4,9 @@
 //! pyFM (WKS + ZoomOut) as references where they finish.
 //!
 //! The pairs are the generated humanoid in pose 0 and pose 3 (limb thickness 1.2, as in the
-//! issue). `synth` makes up to 200K vertices; larger pairs are the 62.5K/125K/250K-vertex
-//! figures split 1:4 by edge midpoints, once or twice (the same split of both poses, so the
-//! ground truth stays the identity at every size).
+//! issue). `synth` makes up to 200K vertices; larger pairs are smaller figures split 1:4 at
+//! edge midpoints: 250K and 500K once (62.5K, 125K), 1M twice (62.5K). Both poses split the
+//! same way, so the ground truth stays the identity at every size.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
