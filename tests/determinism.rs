@@ -6,10 +6,14 @@ use shapecorr::synth::{self, FigureKind, FigureSpec};
 use shapecorr::{Eigenbasis, NoProgress, PointwiseCorrespondence, Shape};
 
 fn humanoid(pose: usize) -> Shape {
+    humanoid_of(pose, 3000)
+}
+
+fn humanoid_of(pose: usize, vertices: usize) -> Shape {
     let mesh = synth::figure(&FigureSpec {
         kind: FigureKind::Humanoid,
         pose,
-        target_vertices: 3000,
+        target_vertices: vertices,
         ..Default::default()
     })
     .unwrap();
@@ -103,17 +107,7 @@ fn pointwise_result_graphs_are_bit_identical_for_one_and_two_threads() {
 
 #[test]
 fn the_multiresolution_path_is_identical_for_one_and_two_threads() {
-    let dense = |pose| {
-        let mesh = synth::figure(&FigureSpec {
-            kind: FigureKind::Humanoid,
-            pose,
-            target_vertices: 8000,
-            ..Default::default()
-        })
-        .unwrap();
-        Shape::mesh(mesh.vertices, &mesh.triangles).unwrap()
-    };
-    let (a, b) = (dense(0), dense(3));
+    let (a, b) = (humanoid_of(0, 8000), humanoid_of(3, 8000));
     let mut options = Options::default();
     options.params.multiresolution.above = 4000;
     options.params.multiresolution.proxy_vertices = 2000;
