@@ -13,7 +13,7 @@
 use std::time::{Duration, Instant};
 
 use crate::progress::{Progress, Stage};
-use crate::spectral::eigen::{effective_threads, eigensolver_bytes, EigenParams};
+use crate::spectral::eigen::{effective_threads, eigensolver_bytes, EigenParams, CONCURRENT_BELOW};
 use crate::{Error, Result};
 
 /// The limits of one job.
@@ -120,10 +120,16 @@ pub fn estimate(job: &Job) -> Estimate {
         n_eigenpairs: job.eigenpairs.max(1),
         ..Default::default()
     };
-    // Both shapes and their bases are kept for the pair; one eigensolve runs at a time.
+    // Both shapes and their bases are kept for the pair; the two eigensolves run together
+    // up to `CONCURRENT_BELOW` vertices, else one at a time.
     let kept = (n_a + n_b) * (SHAPE_BYTES_PER_VERTEX + 8 * k.min(largest));
-    let eigensolve =
-        eigensolver_bytes(largest as usize, &eigen) + largest * FACTOR_NONZEROS_PER_VERTEX * 12;
+    let solve =
+        |n: u64| eigensolver_bytes(n as usize, &eigen) + n * FACTOR_NONZEROS_PER_VERTEX * 12;
+    let eigensolve = if largest as usize <= CONCURRENT_BELOW {
+        solve(n_a) + solve(n_b)
+    } else {
+        solve(largest)
+    };
     let conversion = if job.conversions > 0 {
         let c = job.conversion_size as u64;
         // The embedding of A (double and single precision, row-major copy) and B's rows,

@@ -213,13 +213,7 @@ impl Correspondence {
         progress: &mut dyn Progress,
     ) -> Result<Correspondence> {
         let started = Instant::now();
-        let basis_a = Eigenbasis::compute_with_progress(a, &params.eigen, progress)
-            .map_err(|e| e.in_shape('A'))?;
-        let t_a = started.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let basis_b = Eigenbasis::compute_with_progress(b, &params.eigen, progress)
-            .map_err(|e| e.in_shape('B'))?;
-        let t_b = t.elapsed().as_secs_f64();
+        let ([basis_a, basis_b], [t_a, t_b]) = Eigenbasis::pair((a, b), &params.eigen, progress)?;
         let mut result = Correspondence::from_bases(a, &basis_a, b, &basis_b, params, progress)?;
         result.timings.eigenbasis_a = t_a;
         result.timings.eigenbasis_b = t_b;

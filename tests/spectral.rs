@@ -362,3 +362,42 @@ fn cancelling_from_the_progress_callback_stops_the_eigensolver() {
         "the solver stops at the first report answered with false"
     );
 }
+
+#[test]
+fn a_pair_of_eigenbases_is_the_two_computed_alone_and_can_be_cancelled() {
+    let (a, b) = (bumpy_sphere(), sphere(4));
+    let params = small_params();
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Eigenbasis::pair((&a, &b), &params, &mut NoProgress).unwrap())
+    };
+    let alone = [&a, &b].map(|s| Eigenbasis::compute(s, &params).unwrap());
+    // Two threads solve the two side by side, one thread one after the other.
+    for threads in [1, 2] {
+        let (pair, seconds) = on(threads);
+        for (side, basis) in pair.iter().enumerate() {
+            assert_eq!(basis.values, alone[side].values, "{threads} threads");
+            assert!(basis.vectors == alone[side].vectors, "{threads} threads");
+            assert!(seconds[side] > 0.0);
+        }
+    }
+
+    // The first report comes before the solves start, the second while they run (the
+    // pair takes about 0.1 s, a report comes every 25 ms).
+    let mut reports = Vec::new();
+    let mut cancel_at_the_second = |stage: shapecorr::Stage, fraction: f32| {
+        reports.push((stage, fraction));
+        reports.len() < 2
+    };
+    let result = Eigenbasis::pair((&a, &b), &EigenParams::default(), &mut cancel_at_the_second);
+    assert!(
+        matches!(result, Err(shapecorr::Error::Cancelled)),
+        "{:?}",
+        result.map(|_| ())
+    );
+    assert_eq!(reports.len(), 2, "nothing is reported after the cancel");
+    assert!(reports.iter().all(|r| (0.0..=1.0).contains(&r.1)));
+}

@@ -801,13 +801,8 @@ impl PointwiseCorrespondence {
         progress: &mut dyn Progress,
     ) -> Result<PointwiseCorrespondence> {
         let started = Instant::now();
-        let basis_a =
-            Eigenbasis::compute_with_progress(a, eigen, progress).map_err(|e| e.in_shape('A'))?;
-        let eigenbasis_a = started.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let basis_b =
-            Eigenbasis::compute_with_progress(b, eigen, progress).map_err(|e| e.in_shape('B'))?;
-        let eigenbasis_b = t.elapsed().as_secs_f64();
+        let ([basis_a, basis_b], [eigenbasis_a, eigenbasis_b]) =
+            Eigenbasis::pair((a, b), eigen, progress)?;
         let (regions, map) =
             regions_and_map((a, &basis_a), (b, &basis_b), params, pointwise, progress)?;
         Ok(PointwiseCorrespondence {

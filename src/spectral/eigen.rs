@@ -11,6 +11,8 @@
 //! start block comes from a fixed seed, so results are deterministic.
 //! Small shapes use a dense eigensolver instead.
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use faer::dyn_stack::MemBuffer;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::ReborrowMut;
@@ -18,7 +20,7 @@ use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::progress::{check, NoProgress, Progress, Stage};
+use crate::progress::{check, polled, NoProgress, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::laplacian::Laplacian;
 use crate::spectral::sparse::SparseCholesky;
@@ -65,6 +67,14 @@ impl Default for EigenParams {
         }
     }
 }
+
+/// Largest shape, in vertices, whose eigenbasis [`Eigenbasis::pair`] computes at the same
+/// time as the other shape's. The solver's products gain little from a second thread
+/// (FAUST, 6,890 vertices: 0.255 s on one thread, 0.246 s on two, 2-core AMD EPYC), so two
+/// solves side by side take the time of one; above this size they run one after the other
+/// so that the peak memory stays one solve's. Not tuned: a size where two solves hold
+/// under 250 MiB.
+pub const CONCURRENT_BELOW: usize = 20_000;
 
 /// Default [`EigenParams::max_vertices`]: 2 million vertices. Measured (issue 19): a
 /// 300K-vertex pair took 289 s and 1.47 GB on a 2-core machine, so 2M is about 10 GB and
@@ -154,6 +164,48 @@ impl Eigenbasis {
             vectors,
             mass,
             input_area: laplacian.input_area,
+        })
+    }
+
+    /// The eigenbases of shapes A and B and the seconds each took, errors naming the shape.
+    /// Shapes of at most [`CONCURRENT_BELOW`] vertices are solved at the same time, one per
+    /// thread; progress is then the mean of the two.
+    pub fn pair(
+        (a, b): (&Shape, &Shape),
+        params: &EigenParams,
+        progress: &mut dyn Progress,
+    ) -> Result<([Eigenbasis; 2], [f64; 2])> {
+        let timed = |shape: &Shape, name: char, progress: &mut dyn Progress| {
+            let started = std::time::Instant::now();
+            let basis = Eigenbasis::compute_with_progress(shape, params, progress)
+                .map_err(|e| e.in_shape(name))?;
+            Ok::<_, Error>((basis, started.elapsed().as_secs_f64()))
+        };
+        let largest = a.active_vertices().len().max(b.active_vertices().len());
+        if largest > CONCURRENT_BELOW || rayon::current_num_threads() < 2 {
+            let (basis_a, t_a) = timed(a, 'A', progress)?;
+            let (basis_b, t_b) = timed(b, 'B', progress)?;
+            return Ok(([basis_a, basis_b], [t_a, t_b]));
+        }
+        polled(progress, Stage::Eigenbasis, (0.0, 1.0), |cancel| {
+            let halves = [AtomicU32::new(0), AtomicU32::new(0)];
+            let half = |i: usize| {
+                let halves = &halves;
+                move |_: Stage, fraction: f32| {
+                    halves[i].store(fraction.to_bits(), Ordering::Relaxed);
+                    let done = halves
+                        .iter()
+                        .map(|h| f32::from_bits(h.load(Ordering::Relaxed)));
+                    cancel.set_fraction(done.sum::<f32>() / 2.0);
+                    cancel.check().is_ok()
+                }
+            };
+            let (result_a, result_b) = rayon::join(
+                || timed(a, 'A', &mut half(0)),
+                || timed(b, 'B', &mut half(1)),
+            );
+            let ((basis_a, t_a), (basis_b, t_b)) = (result_a?, result_b?);
+            Ok(([basis_a, basis_b], [t_a, t_b]))
         })
     }
 
