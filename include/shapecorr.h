@@ -56,6 +56,9 @@
 // vertex (the multiresolution path, above `proxy_above` vertices).
 #define SC_STAGE_PROXY 8
 
+// Carrying data from A to B (`sc_surface_map_new`).
+#define SC_STAGE_TRANSFER 9
+
 // Side A: the first shape given to `sc_match`.
 #define SC_SIDE_A 0
 
@@ -118,6 +121,16 @@
 
 // No repair: the shape is used as given.
 #define SC_REPAIR_NONE 0
+
+// Transfer mode: the weighted mean of the three vertices' values (continuous data).
+#define SC_TRANSFER_INTERPOLATE 0
+
+// Transfer mode: the value of the nearest of the three vertices (labels, ids).
+#define SC_TRANSFER_NEAREST 1
+
+// Transfer mode: skin weights (interpolated, at most `max_influences` kept, each row of B
+// scaled to sum to 1; A's values must be non-negative).
+#define SC_TRANSFER_WEIGHTS 2
 
 // Status of every fallible call. The numbers never change meaning; new codes are added.
 enum sc_status
@@ -185,6 +198,11 @@ typedef struct sc_pointwise sc_pointwise;
 // handle may be used from several threads at once (e.g. in concurrent `sc_match` calls).
 // Free it with `sc_shape_free`.
 typedef struct sc_shape sc_shape;
+
+// Where every vertex of B lands on A's surface: three vertices of A and their weights.
+// Immutable: one handle may be read from several threads at once. Free it with
+// `sc_surface_map_free`.
+typedef struct ScSurfaceMap ScSurfaceMap;
 
 // The result of `sc_symmetry_detect`. Immutable: one handle may be read from several
 // threads at once. Free it with `sc_symmetry_free`.
@@ -768,6 +786,66 @@ sc_status sc_symmetry_region_groups(const sc_symmetry *symmetry, uint32_t *out_g
 // # Safety
 // `symmetry` must be live; `out_rgba` must point to `len` writable bytes.
 sc_status sc_symmetry_colors(const sc_symmetry *symmetry, uint8_t *out_rgba, size_t len);
+
+// The surface map of a pointwise map: for every vertex of B, a point of A's surface (the
+// vertex map smoothed over B's neighbours and projected onto A's triangles). `a` and `b`
+// must be the shapes `pointwise` was computed from. `progress` may be NULL; its stage is
+// `SC_STAGE_TRANSFER`.
+//
+// Errors: `SC_STATUS_INVALID_PARAMETER` when the shapes' vertex counts are not the map's,
+// `SC_STATUS_CANCELLED`.
+//
+// # Safety
+// `a`, `b`, `pointwise` must be live; `progress` NULL or a function safe to call with
+// `userdata`; `out_map` writable.
+sc_status sc_surface_map_new(const sc_shape *a,
+                             const sc_shape *b,
+                             const sc_pointwise *pointwise,
+                             sc_progress_callback progress,
+                             void *userdata,
+                             ScSurfaceMap **out_map);
+
+// Frees a surface map; NULL is a no-op.
+//
+// # Safety
+// `map` must be NULL or live, not used afterwards.
+void sc_surface_map_free(ScSurfaceMap *map);
+
+// Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`); 0 for NULL or a bad side.
+//
+// # Safety
+// `map` must be NULL or live.
+size_t sc_surface_map_n_vertices(const ScSurfaceMap *map, uint32_t side);
+
+// Copies where every vertex of B lands: three vertices of A per vertex of B into
+// `out_vertices` and their weights (summing to 1, heaviest first) into `out_weights`, each
+// of `len` = 3 x `sc_surface_map_n_vertices(map, SC_SIDE_B)` elements.
+//
+// # Safety
+// `map` must be live; each output must point to `len` writable elements.
+sc_status sc_surface_map_points(const ScSurfaceMap *map,
+                                uint32_t *out_vertices,
+                                double *out_weights,
+                                size_t len);
+
+// Carries `values_a` (A's vertices x `channels`, row-major, `n_values` elements) to B's
+// vertices by `mode` (`SC_TRANSFER_*`; `max_influences` is used by `SC_TRANSFER_WEIGHTS`
+// only, 0 for no limit), into `out_values_b` of `len` = B's vertices x `channels` elements.
+//
+// Errors: `SC_STATUS_INVALID_PARAMETER` for a wrong length, an unknown mode, a value that
+// is not finite or a negative skin weight (`sc_last_error` names the vertex).
+//
+// # Safety
+// `map` must be live; `values_a` must point to `n_values` readable elements and
+// `out_values_b` to `len` writable ones.
+sc_status sc_surface_map_transfer(const ScSurfaceMap *map,
+                                  const double *values_a,
+                                  size_t n_values,
+                                  size_t channels,
+                                  uint32_t mode,
+                                  uint32_t max_influences,
+                                  double *out_values_b,
+                                  size_t len);
 
 #ifdef __cplusplus
 }  // extern "C"

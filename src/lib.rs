@@ -62,6 +62,7 @@ pub mod regions;
 pub mod shape;
 pub mod spectral;
 pub mod synth;
+pub mod transfer;
 
 pub use correspondence::{Correspondence, Params, Symmetry};
 pub use error::{Error, Result};

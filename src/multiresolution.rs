@@ -210,7 +210,7 @@ fn distance(p: &[f64; 3], q: &[f64; 3]) -> f64 {
 
 /// Mean edge length of a mesh; for a point cloud, the mean distance to the nearest other
 /// point.
-fn mean_edge_length(shape: &Shape) -> f64 {
+pub(crate) fn mean_edge_length(shape: &Shape) -> f64 {
     let p = shape.vertices();
     let edges = shape.edges();
     if !edges.is_empty() {

@@ -22,6 +22,8 @@ pub enum Stage {
     /// Simplifying a dense shape to its proxy and bringing the answers back to every input
     /// vertex (the multiresolution path, [`crate::multiresolution`]).
     Proxy = 8,
+    /// Carrying data from A to B: the surface map and the transfer ([`crate::transfer`]).
+    Transfer = 9,
 }
 
 /// Receives progress and may cancel: `report` returns `false` to stop the work, which then

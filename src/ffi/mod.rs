@@ -24,6 +24,7 @@ mod params;
 mod pointwise;
 mod shape;
 mod symmetry;
+mod transfer;
 
 pub use boundary::{sc_last_error, sc_status_str, ScStatus};
 pub use correspondence::*;
@@ -31,6 +32,7 @@ pub use params::*;
 pub use pointwise::*;
 pub use shape::*;
 pub use symmetry::*;
+pub use transfer::*;
 
 use std::ffi::{c_char, c_void};
 
@@ -61,6 +63,8 @@ pub const SC_STAGE_POINTWISE_MAP: u32 = 7;
 /// Simplifying a dense shape to its proxy and bringing the answers back to every input
 /// vertex (the multiresolution path, above `proxy_above` vertices).
 pub const SC_STAGE_PROXY: u32 = 8;
+/// Carrying data from A to B (`sc_surface_map_new`).
+pub const SC_STAGE_TRANSFER: u32 = 9;
 
 /// Progress callback: called on the calling thread with a stage (`SC_STAGE_*`) and the
 /// fraction of that stage done (0 to 1). Return `false` to cancel: the call then returns
@@ -140,6 +144,7 @@ mod tests {
         assert_eq!(SC_STAGE_SYMMETRY_BREAKING, Stage::SymmetryBreaking as u32);
         assert_eq!(SC_STAGE_POINTWISE_MAP, Stage::PointwiseMap as u32);
         assert_eq!(SC_STAGE_PROXY, Stage::Proxy as u32);
+        assert_eq!(SC_STAGE_TRANSFER, Stage::Transfer as u32);
     }
 
     /// The handles' thread-safety promises in the header rest on these.
@@ -151,5 +156,6 @@ mod tests {
         check::<ScCorrespondence>();
         check::<ScSymmetry>();
         check::<ScPointwise>();
+        check::<ScSurfaceMap>();
     }
 }

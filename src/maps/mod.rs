@@ -5,3 +5,4 @@
 pub mod fmap;
 pub mod hypotheses;
 pub mod pointwise;
+pub mod surface;

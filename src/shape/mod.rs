@@ -11,6 +11,7 @@ pub mod io;
 pub mod neighbors;
 pub mod proxy;
 pub mod repair;
+pub mod surface_point;
 
 use std::collections::HashMap;
 

@@ -221,6 +221,79 @@ pub fn figure_poses(
         .collect())
 }
 
+/// A figure's rest mesh with its skinning weights: the ground truth of a transfer (issue
+/// 21). Every pose and proportion of the figure at this resolution is this mesh moved by
+/// these weights, so its weights are every such figure's.
+#[derive(Debug, Clone)]
+pub struct Rig {
+    /// The figure.
+    pub kind: FigureKind,
+    /// The rest mesh (pose 0, default proportions).
+    pub rest: FigureMesh,
+    /// Number of bones.
+    pub n_bones: usize,
+    /// Every vertex's weight per bone (`n_bones` per vertex, row-major), each row summing
+    /// to 1.
+    pub weights: Vec<f64>,
+}
+
+/// The rig of a figure at a resolution (arguments as [`figure`]'s).
+pub fn rig(kind: FigureKind, target_vertices: usize) -> Result<Rig> {
+    validate(kind, target_vertices, &Proportions::default(), &[0])?;
+    let skel = skeleton::skeleton(kind);
+    let rest = rest_mesh(&skel, target_vertices)?;
+    let weights = skinning::weights(&skel, &rest.vertices).to_rows(skel.bones.len());
+    Ok(Rig {
+        kind,
+        rest,
+        n_bones: skel.bones.len(),
+        weights,
+    })
+}
+
+impl Rig {
+    /// The rest mesh's vertices moved to `pose` with `proportions` by `weights` (the rig's
+    /// own give [`figure_poses`]' vertices; transferred ones show how well they pose).
+    /// Errors unless `weights` has `n_bones` non-negative values per vertex summing to 1.
+    pub fn deform(
+        &self,
+        weights: &[f64],
+        proportions: Proportions,
+        pose: usize,
+    ) -> Result<Vec<[f64; 3]>> {
+        validate(self.kind, TARGET_RANGE.0, &proportions, &[pose])?;
+        if weights.len() != self.rest.vertices.len() * self.n_bones {
+            return Err(invalid(
+                "weights",
+                format!(
+                    "has {} values, the rig has {} vertices x {} bones",
+                    weights.len(),
+                    self.rest.vertices.len(),
+                    self.n_bones
+                ),
+            ));
+        }
+        for (v, row) in weights.chunks_exact(self.n_bones).enumerate() {
+            let total: f64 = row.iter().sum();
+            if row.iter().any(|&w| !(w >= 0.0)) || (total - 1.0).abs() > 1e-6 {
+                return Err(invalid(
+                    "weights",
+                    format!("vertex {v}: weights must be non-negative and sum to 1"),
+                ));
+            }
+        }
+        let skel = skeleton::skeleton(self.kind);
+        let weights = skinning::Weights::from_rows(weights, self.n_bones);
+        Ok(skinning::deform(
+            &skel,
+            &weights,
+            &self.rest.vertices,
+            &proportions,
+            &skeleton::pose(self.kind, &skel, pose),
+        ))
+    }
+}
+
 fn invalid(name: &'static str, reason: String) -> Error {
     Error::InvalidParameter { name, reason }
 }

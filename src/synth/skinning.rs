@@ -30,6 +30,37 @@ pub(crate) struct Weights {
 }
 
 impl Weights {
+    /// Weights from dense rows (`n_bones` per vertex, row-major): the non-zero ones.
+    pub fn from_rows(rows: &[f64], n_bones: usize) -> Weights {
+        let mut out = Weights {
+            start: vec![0],
+            bone: Vec::new(),
+            weight: Vec::new(),
+        };
+        for row in rows.chunks_exact(n_bones) {
+            for (c, &w) in row.iter().enumerate() {
+                if w > 0.0 {
+                    out.bone.push(c as u16);
+                    out.weight.push(w);
+                }
+            }
+            out.start.push(out.bone.len());
+        }
+        out
+    }
+
+    /// Dense rows, `n_bones` per vertex, row-major.
+    pub fn to_rows(&self, n_bones: usize) -> Vec<f64> {
+        let n = self.start.len() - 1;
+        let mut rows = vec![0.0; n * n_bones];
+        for v in 0..n {
+            for (c, w) in self.of(v) {
+                rows[v * n_bones + c] = w;
+            }
+        }
+        rows
+    }
+
     /// `(bone, weight)` pairs of vertex `v`.
     pub fn of(&self, v: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let r = self.start[v]..self.start[v + 1];

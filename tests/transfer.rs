@@ -1,0 +1,304 @@
+//! Transfer through the surface map, against the exact ground truth of generated figures
+//! (issue 21): skin weights, re-posing with them, and where B's vertices land on A.
+//!
+//! The figures' rest meshes at two resolutions are two samplings of one surface, so the true
+//! image of a vertex of B is the closest point of A's rest mesh to B's rest vertex, and B's
+//! true skin weights are its rig's. The figures printed here (`cargo test --release --test
+//! transfer -- --nocapture`) are the ones in docs/transfer.md.
+
+use shapecorr::maps::surface::SurfaceMap;
+use shapecorr::shape::neighbors::PointTree;
+use shapecorr::shape::surface_point::closest_on_triangle;
+use shapecorr::synth::{self, FigureKind, Proportions, Rig};
+use shapecorr::transfer::TransferMode;
+use shapecorr::{NoProgress, Params, PointwiseCorrespondence, PointwiseParams, Shape};
+
+/// B's body: thicker and longer limbs than A's.
+const B_BODY: Proportions = Proportions {
+    limb_length: 1.1,
+    limb_thickness: 1.2,
+};
+/// The pose B is moved to for the re-posing test (A is in the rest pose, B in each other
+/// pose in turn).
+const REPOSE: usize = 5;
+
+struct Pair {
+    rig_a: Rig,
+    rig_b: Rig,
+    shape_a: Shape,
+    shape_b: Shape,
+    p2p_ba: Vec<u32>,
+    confidence: Option<f64>,
+}
+
+/// A in the rest pose at `n_a` vertices, B posed with another body at `n_b`, and the map.
+fn pair(n_a: usize, n_b: usize, pose_b: usize) -> Pair {
+    let rig_a = synth::rig(FigureKind::Humanoid, n_a).unwrap();
+    let rig_b = synth::rig(FigureKind::Humanoid, n_b).unwrap();
+    let shape_a = Shape::mesh(rig_a.rest.vertices.clone(), &rig_a.rest.triangles).unwrap();
+    let posed_b = rig_b.deform(&rig_b.weights, B_BODY, pose_b).unwrap();
+    let shape_b = Shape::mesh(posed_b, &rig_b.rest.triangles).unwrap();
+    let result = PointwiseCorrespondence::compute(
+        &shape_a,
+        &shape_b,
+        &Params::default(),
+        &PointwiseParams::default(),
+        &mut NoProgress,
+    )
+    .unwrap();
+    Pair {
+        confidence: result.confidence(),
+        p2p_ba: result.map.p2p_ba,
+        rig_a,
+        rig_b,
+        shape_a,
+        shape_b,
+    }
+}
+
+/// For every rest vertex of B, the closest point of A's rest mesh (the true image).
+fn true_images(rig_a: &Rig, rig_b: &Rig) -> Vec<[f64; 3]> {
+    let (va, ta) = (&rig_a.rest.vertices, &rig_a.rest.triangles);
+    let mut incident = vec![Vec::new(); va.len()];
+    for (f, t) in ta.iter().enumerate() {
+        for &v in t {
+            incident[v as usize].push(f);
+        }
+    }
+    let tree = PointTree::new(va);
+    rig_b
+        .rest
+        .vertices
+        .iter()
+        .map(|p| {
+            let mut best = (f64::INFINITY, [0.0; 3]);
+            for (v, _) in tree.nearest_k(p, 8) {
+                for &f in &incident[v] {
+                    let corners = ta[f].map(|i| va[i as usize]);
+                    let (d2, w) = closest_on_triangle(p, &corners);
+                    if d2 < best.0 {
+                        best = (
+                            d2,
+                            [0, 1, 2].map(|c| (0..3).map(|i| w[i] * corners[i][c]).sum()),
+                        );
+                    }
+                }
+            }
+            best.1
+        })
+        .collect()
+}
+
+fn distance(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+    (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn height(points: &[[f64; 3]]) -> f64 {
+    let ys = points.iter().map(|p| p[1]);
+    ys.clone().fold(f64::MIN, f64::max) - ys.fold(f64::MAX, f64::min)
+}
+
+/// Mean and largest of `errors`.
+fn mean_max(errors: &[f64]) -> (f64, f64) {
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    (mean, errors.iter().copied().fold(0.0, f64::max))
+}
+
+/// Mean absolute error per vertex and bone.
+fn weight_error(got: &[f64], truth: &[f64]) -> f64 {
+    got.iter()
+        .zip(truth)
+        .map(|(g, t)| (g - t).abs())
+        .sum::<f64>()
+        / got.len() as f64
+}
+
+/// Mean vertex error of B re-posed with `weights`, against B re-posed with its own weights,
+/// over B's height in that pose.
+fn repose_error(rig_b: &Rig, weights: &[f64]) -> f64 {
+    let truth = rig_b.deform(&rig_b.weights, B_BODY, REPOSE).unwrap();
+    let got = rig_b.deform(weights, B_BODY, REPOSE).unwrap();
+    let errors: Vec<f64> = got
+        .iter()
+        .zip(&truth)
+        .map(|(g, t)| distance(g, t))
+        .collect();
+    mean_max(&errors).0 / height(&truth)
+}
+
+/// Mean over B's edges of how far the difference of the images of its two ends is from
+/// the true difference, over A's mean edge length: 0 for a map as smooth as the truth.
+fn roughness(shape_b: &Shape, images: &[[f64; 3]], truth: &[[f64; 3]], edge_a: f64) -> f64 {
+    let edges = shape_b.edges();
+    let sum: f64 = edges
+        .iter()
+        .map(|&(i, j)| {
+            let (i, j) = (i as usize, j as usize);
+            let d = [0, 1, 2].map(|c| (images[i][c] - images[j][c]) - (truth[i][c] - truth[j][c]));
+            distance(&d, &[0.0; 3])
+        })
+        .sum();
+    sum / edges.len() as f64 / edge_a
+}
+
+/// What one pair measures, for the vertex map and the surface map.
+#[derive(Debug)]
+struct Figures {
+    confidence: Option<f64>,
+    /// Mean distance of the images to the truth, over A's height.
+    image_error: [f64; 2],
+    /// [`roughness`] of the images.
+    roughness: [f64; 2],
+    /// Skin weights' mean absolute error per vertex and bone.
+    weights: [f64; 2],
+    /// Re-posing error over the height.
+    repose: [f64; 2],
+}
+
+fn measure(n_a: usize, n_b: usize, pose_b: usize) -> Figures {
+    let p = pair(n_a, n_b, pose_b);
+    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let truth = true_images(&p.rig_a, &p.rig_b);
+    let rest_a = &p.rig_a.rest.vertices;
+    let scale = height(rest_a);
+    let edges_a = p.shape_a.edges();
+    let edge_a = edges_a
+        .iter()
+        .map(|&(i, j)| distance(&rest_a[i as usize], &rest_a[j as usize]))
+        .sum::<f64>()
+        / edges_a.len() as f64;
+    let images = [
+        p.p2p_ba
+            .iter()
+            .map(|&v| rest_a[v as usize])
+            .collect::<Vec<_>>(),
+        map.positions(rest_a),
+    ];
+    let image_error = images.clone().map(|im| {
+        let errors: Vec<f64> = im
+            .iter()
+            .zip(&truth)
+            .map(|(q, t)| distance(q, t) / scale)
+            .collect();
+        mean_max(&errors).0
+    });
+    let roughness = images.map(|im| roughness(&p.shape_b, &im, &truth, edge_a));
+    let weights = |mode| {
+        map.transfer(&p.rig_a.weights, p.rig_a.n_bones, mode)
+            .unwrap()
+    };
+    let carried = [
+        weights(TransferMode::Nearest),
+        weights(TransferMode::Weights { max_influences: 0 }),
+    ];
+    let figures = Figures {
+        confidence: p.confidence,
+        image_error,
+        roughness,
+        weights: [0, 1].map(|i| weight_error(&carried[i], &p.rig_b.weights)),
+        repose: [0, 1].map(|i| repose_error(&p.rig_b, &carried[i])),
+    };
+    eprintln!("transfer {n_a} -> {n_b}, pose {pose_b} (vertex map, surface map): {figures:?}");
+    figures
+}
+
+/// Generated pairs: A in the rest pose at 4,000 vertices, B at 8,000 (finer, where a
+/// surface map matters) in each of the six other poses with thicker, longer limbs.
+#[test]
+fn skin_weights_carried_to_another_pose_and_body_pose_it_as_its_own() {
+    let figures: Vec<Figures> = (1..7).map(|pose| measure(4000, 8000, pose)).collect();
+    // A map that swaps sides carries the left arm's weights to the right arm: its images
+    // are a good part of the height away.
+    let swapped = |f: &Figures| f.image_error[0] > 0.05;
+    let right: Vec<&Figures> = figures.iter().filter(|f| !swapped(f)).collect();
+    eprintln!(
+        "{} of {} maps swapped sides, confidences {:?}",
+        figures.len() - right.len(),
+        figures.len(),
+        figures
+            .iter()
+            .filter(|f| swapped(f))
+            .map(|f| f.confidence)
+            .collect::<Vec<_>>()
+    );
+    // The issue's targets, on every pair whose map is right: weights within 0.05 per vertex
+    // and bone, re-posing within 2% of the height.
+    for f in &right {
+        assert!(f.weights[1] <= 0.05 && f.repose[1] <= 0.02, "{f:?}");
+    }
+    // Measured on 2026-12-03: two of the six maps (poses 3 and 6) swap left and right and are
+    // not flagged (confidence 0.56 and 0.65; docs/transfer.md). The count may not grow.
+    assert!(right.len() >= 4, "{figures:?}");
+    // The surface map lands nearer the truth and is smoother than the vertex map.
+    let mean =
+        |f: &dyn Fn(&Figures) -> f64| right.iter().map(|x| f(x)).sum::<f64>() / right.len() as f64;
+    assert!(mean(&|f| f.image_error[1]) < mean(&|f| f.image_error[0]));
+    assert!(mean(&|f| f.roughness[1]) < mean(&|f| f.roughness[0]));
+}
+
+#[test]
+fn weights_mode_keeps_rows_normalised_with_at_most_the_influences_asked() {
+    let p = pair(3000, 3000, 3);
+    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let bones = p.rig_a.n_bones;
+    for limit in [1, 2, 4] {
+        let out = map
+            .transfer(
+                &p.rig_a.weights,
+                bones,
+                TransferMode::Weights {
+                    max_influences: limit,
+                },
+            )
+            .unwrap();
+        for row in out.chunks_exact(bones) {
+            assert!(row.iter().all(|&w| w >= 0.0));
+            assert!(row.iter().filter(|&&w| w > 0.0).count() <= limit);
+            assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn nearest_mode_carries_labels_unchanged_and_interpolation_is_exact_on_linear_data() {
+    let p = pair(3000, 3000, 3);
+    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    // Labels: every value of B is one of A's.
+    let labels: Vec<f64> = (0..p.shape_a.n_vertices())
+        .map(|v| (v % 7) as f64)
+        .collect();
+    let out = map.transfer(&labels, 1, TransferMode::Nearest).unwrap();
+    assert!(out
+        .iter()
+        .all(|x| x.fract() == 0.0 && (0.0..7.0).contains(x)));
+    // A linear function of A's positions interpolates to the same function of the images.
+    let rest_a = &p.rig_a.rest.vertices;
+    let linear: Vec<f64> = rest_a.iter().map(|q| 2.0 * q[0] - q[1] + 0.5).collect();
+    let out = map.transfer(&linear, 1, TransferMode::Interpolate).unwrap();
+    for (got, q) in out.iter().zip(map.positions(rest_a)) {
+        assert!((got - (2.0 * q[0] - q[1] + 0.5)).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn bad_values_are_refused_with_the_vertex_named() {
+    let p = pair(3000, 3000, 3);
+    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let n = p.shape_a.n_vertices();
+    let message = |values: &[f64], channels, mode| {
+        map.transfer(values, channels, mode)
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(message(&vec![0.0; n + 1], 1, TransferMode::Interpolate).contains("vertices"));
+    assert!(message(&[], 0, TransferMode::Interpolate).contains("channels"));
+    let mut values = vec![0.5; 2 * n];
+    values[7] = f64::NAN;
+    assert!(message(&values, 2, TransferMode::Interpolate).contains("vertex 3 channel 1"));
+    values[7] = -0.1;
+    assert!(message(&values, 2, TransferMode::Weights { max_influences: 0 }).contains("vertex 3"));
+    assert!(SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba[1..]).is_err());
+    let mut wrong = p.p2p_ba.clone();
+    wrong[0] = n as u32;
+    assert!(SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &wrong).is_err());
+}
