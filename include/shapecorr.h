@@ -202,7 +202,7 @@ typedef struct sc_shape sc_shape;
 // Where every vertex of B lands on A's surface: three vertices of A and their weights.
 // Immutable: one handle may be read from several threads at once. Free it with
 // `sc_surface_map_free`.
-typedef struct ScSurfaceMap ScSurfaceMap;
+typedef struct sc_surface_map sc_surface_map;
 
 // The result of `sc_symmetry_detect`. Immutable: one handle may be read from several
 // threads at once. Free it with `sc_symmetry_free`.
@@ -792,7 +792,7 @@ sc_status sc_symmetry_colors(const sc_symmetry *symmetry, uint8_t *out_rgba, siz
 // must be the shapes `pointwise` was computed from. `progress` may be NULL; its stage is
 // `SC_STAGE_TRANSFER`.
 //
-// Errors: `SC_STATUS_INVALID_PARAMETER` when the shapes' vertex counts are not the map's,
+// Errors: `SC_STATUS_INVALID_ARGUMENT` when the shapes' vertex counts are not the map's,
 // `SC_STATUS_CANCELLED`.
 //
 // # Safety
@@ -803,19 +803,19 @@ sc_status sc_surface_map_new(const sc_shape *a,
                              const sc_pointwise *pointwise,
                              sc_progress_callback progress,
                              void *userdata,
-                             ScSurfaceMap **out_map);
+                             sc_surface_map **out_map);
 
 // Frees a surface map; NULL is a no-op.
 //
 // # Safety
 // `map` must be NULL or live, not used afterwards.
-void sc_surface_map_free(ScSurfaceMap *map);
+void sc_surface_map_free(sc_surface_map *map);
 
 // Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`); 0 for NULL or a bad side.
 //
 // # Safety
 // `map` must be NULL or live.
-size_t sc_surface_map_n_vertices(const ScSurfaceMap *map, uint32_t side);
+size_t sc_surface_map_n_vertices(const sc_surface_map *map, uint32_t side);
 
 // Copies where every vertex of B lands: three vertices of A per vertex of B into
 // `out_vertices` and their weights (summing to 1, heaviest first) into `out_weights`, each
@@ -823,7 +823,7 @@ size_t sc_surface_map_n_vertices(const ScSurfaceMap *map, uint32_t side);
 //
 // # Safety
 // `map` must be live; each output must point to `len` writable elements.
-sc_status sc_surface_map_points(const ScSurfaceMap *map,
+sc_status sc_surface_map_points(const sc_surface_map *map,
                                 uint32_t *out_vertices,
                                 double *out_weights,
                                 size_t len);
@@ -832,13 +832,14 @@ sc_status sc_surface_map_points(const ScSurfaceMap *map,
 // vertices by `mode` (`SC_TRANSFER_*`; `max_influences` is used by `SC_TRANSFER_WEIGHTS`
 // only, 0 for no limit), into `out_values_b` of `len` = B's vertices x `channels` elements.
 //
-// Errors: `SC_STATUS_INVALID_PARAMETER` for a wrong length, an unknown mode, a value that
-// is not finite or a negative skin weight (`sc_last_error` names the vertex).
+// Errors: `SC_STATUS_INVALID_ARGUMENT` for an unknown mode; `SC_STATUS_INVALID_PARAMETER`
+// for a wrong length or count of channels, a value that is not finite or a negative skin
+// weight (`sc_last_error` names the vertex and channel); `SC_STATUS_BUFFER_TOO_SMALL`.
 //
 // # Safety
 // `map` must be live; `values_a` must point to `n_values` readable elements and
 // `out_values_b` to `len` writable ones.
-sc_status sc_surface_map_transfer(const ScSurfaceMap *map,
+sc_status sc_surface_map_transfer(const sc_surface_map *map,
                                   const double *values_a,
                                   size_t n_values,
                                   size_t channels,

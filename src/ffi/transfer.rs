@@ -34,7 +34,7 @@ pub const SC_TRANSFER_WEIGHTS: u32 = 2;
 /// must be the shapes `pointwise` was computed from. `progress` may be NULL; its stage is
 /// `SC_STAGE_TRANSFER`.
 ///
-/// Errors: `SC_STATUS_INVALID_PARAMETER` when the shapes' vertex counts are not the map's,
+/// Errors: `SC_STATUS_INVALID_ARGUMENT` when the shapes' vertex counts are not the map's,
 /// `SC_STATUS_CANCELLED`.
 ///
 /// # Safety
@@ -127,8 +127,9 @@ pub unsafe extern "C" fn sc_surface_map_points(
 /// vertices by `mode` (`SC_TRANSFER_*`; `max_influences` is used by `SC_TRANSFER_WEIGHTS`
 /// only, 0 for no limit), into `out_values_b` of `len` = B's vertices x `channels` elements.
 ///
-/// Errors: `SC_STATUS_INVALID_PARAMETER` for a wrong length, an unknown mode, a value that
-/// is not finite or a negative skin weight (`sc_last_error` names the vertex).
+/// Errors: `SC_STATUS_INVALID_ARGUMENT` for an unknown mode; `SC_STATUS_INVALID_PARAMETER`
+/// for a wrong length or count of channels, a value that is not finite or a negative skin
+/// weight (`sc_last_error` names the vertex and channel); `SC_STATUS_BUFFER_TOO_SMALL`.
 ///
 /// # Safety
 /// `map` must be live; `values_a` must point to `n_values` readable elements and

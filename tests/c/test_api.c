@@ -1040,6 +1040,121 @@ static void test_cancel_huge_restarts(void) {
     sc_shape_free(b);
 }
 
+/* ---------------------------------------------------------------- transfer (issue 21) */
+
+static bool cancel_transfer(void *userdata, uint32_t stage, float fraction) {
+    int *calls = (int *)userdata;
+    (void)fraction;
+    if (stage == SC_STAGE_TRANSFER)
+        (*calls)++;
+    return stage != SC_STAGE_TRANSFER;
+}
+
+/* A map between two poses of a figure, its surface map and the three transfer modes. */
+static void test_transfer(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 2), *other = figure("star5", 0);
+    sc_params *params = pointwise_params();
+    sc_pointwise *p = NULL;
+    sc_surface_map *m = NULL, *sentinel = (sc_surface_map *)&m;
+    size_t na, nb, i, k;
+    double *xyz_a, *x_a, *out, *weights, *rows;
+    uint32_t *corners;
+    int calls = 0;
+    CHECK_STATUS(sc_pointwise_map(a, b, params, NULL, NULL, &p), SC_STATUS_OK);
+    if (p == NULL)
+        goto done;
+    na = sc_shape_n_vertices(a);
+    nb = sc_shape_n_vertices(b);
+    /* Errors: NULLs, shapes that are not the map's, a cancel. */
+    CHECK_STATUS(sc_surface_map_new(NULL, b, p, NULL, NULL, &m), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_surface_map_new(a, b, NULL, NULL, NULL, &m), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_surface_map_new(a, b, p, NULL, NULL, NULL), SC_STATUS_NULL_ARGUMENT);
+    m = sentinel;
+    CHECK_STATUS(sc_surface_map_new(other, b, p, NULL, NULL, &m), SC_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(sc_last_error(), "vertices") != NULL, "message: %s", sc_last_error());
+    CHECK_STATUS(sc_surface_map_new(a, b, p, cancel_transfer, &calls, &m), SC_STATUS_CANCELLED);
+    CHECK(calls == 1 && m == sentinel, "cancelled at the first report, nothing written");
+    CHECK_STATUS(sc_surface_map_new(a, b, p, NULL, NULL, &m), SC_STATUS_OK);
+    CHECK(sc_surface_map_n_vertices(m, SC_SIDE_A) == na, "n A");
+    CHECK(sc_surface_map_n_vertices(m, SC_SIDE_B) == nb, "n B");
+    CHECK(sc_surface_map_n_vertices(m, 5) == 0 && sc_surface_map_n_vertices(NULL, 0) == 0,
+          "bad side, NULL");
+
+    xyz_a = malloc(3 * na * sizeof *xyz_a);
+    x_a = malloc(na * sizeof *x_a);
+    out = malloc(2 * nb * sizeof *out);
+    weights = malloc(3 * nb * sizeof *weights);
+    corners = malloc(3 * nb * sizeof *corners);
+    rows = malloc(2 * na * sizeof *rows);
+    CHECK_STATUS(sc_shape_vertices(a, xyz_a, 3 * na), SC_STATUS_OK);
+    CHECK_STATUS(sc_surface_map_points(m, corners, weights, 3 * nb - 1),
+                 SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_surface_map_points(m, corners, weights, 3 * nb), SC_STATUS_OK);
+    /* Interpolation of A's x coordinate is the points' weighted x. */
+    for (i = 0; i < na; i++)
+        x_a[i] = xyz_a[3 * i];
+    CHECK_STATUS(sc_surface_map_transfer(m, x_a, na, 1, SC_TRANSFER_INTERPOLATE, 0, out, nb),
+                 SC_STATUS_OK);
+    for (i = 0; i < nb; i++) {
+        double x = 0.0, total = 0.0;
+        for (k = 0; k < 3; k++) {
+            CHECK(corners[3 * i + k] < na, "corner %u", corners[3 * i + k]);
+            x += weights[3 * i + k] * x_a[corners[3 * i + k] % na];
+            total += weights[3 * i + k];
+        }
+        CHECK(fabs(total - 1.0) < 1e-9 && fabs(out[i] - x) < 1e-9, "vertex %zu", i);
+    }
+    /* Nearest carries the heaviest corner's value. */
+    CHECK_STATUS(sc_surface_map_transfer(m, x_a, na, 1, SC_TRANSFER_NEAREST, 0, out, nb),
+                 SC_STATUS_OK);
+    for (i = 0; i < nb; i++)
+        CHECK(out[i] == x_a[corners[3 * i] % na], "nearest at %zu", i);
+    /* Skin weights over two bones, one influence kept: a single 1 per row. */
+    for (i = 0; i < na; i++) {
+        rows[2 * i] = xyz_a[3 * i + 1] > 0.0 ? 0.8 : 0.3;
+        rows[2 * i + 1] = 1.0 - rows[2 * i];
+    }
+    CHECK_STATUS(sc_surface_map_transfer(m, rows, 2 * na, 2, SC_TRANSFER_WEIGHTS, 1, out, 2 * nb),
+                 SC_STATUS_OK);
+    for (i = 0; i < nb; i++)
+        CHECK(out[2 * i] + out[2 * i + 1] == 1.0 && out[2 * i] * out[2 * i + 1] == 0.0,
+              "one influence at %zu", i);
+    /* Bad values and modes are refused, naming the vertex; the output is left alone. */
+    out[0] = -7.0;
+    CHECK_STATUS(sc_surface_map_transfer(m, rows, 2 * na - 1, 2, SC_TRANSFER_WEIGHTS, 1, out,
+                                         2 * nb),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_surface_map_transfer(m, rows, 2 * na, 2, 7, 1, out, 2 * nb),
+                 SC_STATUS_INVALID_ARGUMENT);
+    rows[5] = -0.5;
+    CHECK_STATUS(sc_surface_map_transfer(m, rows, 2 * na, 2, SC_TRANSFER_WEIGHTS, 0, out, 2 * nb),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "vertex 2") != NULL, "message: %s", sc_last_error());
+    rows[5] = NAN;
+    CHECK_STATUS(sc_surface_map_transfer(m, rows, 2 * na, 2, SC_TRANSFER_INTERPOLATE, 0, out,
+                                         2 * nb),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_surface_map_transfer(m, x_a, na, 1, SC_TRANSFER_INTERPOLATE, 0, out, nb - 1),
+                 SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_surface_map_transfer(m, NULL, na, 1, SC_TRANSFER_INTERPOLATE, 0, out, nb),
+                 SC_STATUS_NULL_ARGUMENT);
+    CHECK(out[0] == -7.0, "output untouched by failed calls");
+    free(xyz_a);
+    free(x_a);
+    free(out);
+    free(weights);
+    free(corners);
+    free(rows);
+done:
+    sc_surface_map_free(m == sentinel ? NULL : m);
+    sc_surface_map_free(NULL);
+    sc_pointwise_free(p);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+    sc_shape_free(other);
+}
+
 int main(void) {
     const char *q = getenv("SHAPECORR_TEST_QUICK");
     quick = q != NULL && strcmp(q, "1") == 0;
@@ -1060,6 +1175,7 @@ int main(void) {
     test_pointwise_errors();
     test_pointwise_permuted_copy();
     test_pointwise_cancellation();
+    test_transfer();
     test_concurrency();
     printf("%d checks, %d failures%s\n", checks, failures, quick ? " (quick)" : "");
     return failures == 0 ? 0 : 1;

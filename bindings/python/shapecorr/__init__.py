@@ -13,6 +13,8 @@ A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
     result.warning              # a sentence when the answer is doubtful, else None
     pointwise = shapecorr.pointwise_map(a, b)
     pointwise.map_b_to_a        # vertex of A for every vertex of B (numpy uint32)
+    onto = shapecorr.surface_map(a, b, pointwise)
+    onto.transfer(weights_a, mode="weights", max_influences=4)   # A's data on B
 
 Options are the library's named options (``shapecorr.options()``), with the same defaults as
 the command line. Errors raise :class:`ShapecorrError` with the C status and the message.
@@ -39,9 +41,11 @@ __all__ = [
     "Correspondence",
     "Symmetry",
     "PointwiseMap",
+    "SurfaceMap",
     "match",
     "detect_symmetry",
     "pointwise_map",
+    "surface_map",
     "options",
     "version",
     "CONFIDENCE_DOUBTFUL_BELOW",
@@ -639,3 +643,62 @@ def pointwise_map(a, b, progress=None, **options):
     _expect(a, Shape, "a"), _expect(b, Shape, "b")
     params = _Params(options)
     return PointwiseMap(_Progress(progress).run(lib.sc_pointwise_map, a, b, params))
+
+
+class SurfaceMap(_Handle):
+    """The result of :func:`surface_map`: where every vertex of B lands on A's surface
+    (immutable; safe to share between threads)."""
+
+    _free = lib.sc_surface_map_free
+
+    @property
+    def n_vertices_a(self):
+        return lib.sc_surface_map_n_vertices(self, _lib.SIDE_A)
+
+    @property
+    def n_vertices_b(self):
+        return lib.sc_surface_map_n_vertices(self, _lib.SIDE_B)
+
+    @property
+    def points(self):
+        """``(vertices, weights)``: for every vertex of B, three vertices of A (uint32,
+        ``(n_vertices_b, 3)``) and their weights (float64, summing to 1, heaviest first)."""
+        n = self.n_vertices_b
+        vertices = np.empty((n, 3), dtype=np.uint32)
+        weights = np.empty((n, 3), dtype=np.float64)
+        _check(lib.sc_surface_map_points(
+            self, _ptr(vertices, ctypes.c_uint32), _ptr(weights, ctypes.c_double), vertices.size,
+        ))
+        return vertices, weights
+
+    def transfer(self, values, mode="interpolate", max_influences=0):
+        """``values`` on A's vertices (``(n_vertices_a,)`` or ``(n_vertices_a, channels)``)
+        carried to B's vertices, same dimensionality, float64. ``mode``: ``"interpolate"``
+        (continuous data), ``"nearest"`` (labels, ids) or ``"weights"`` (skin weights:
+        non-negative rows, at most ``max_influences`` kept (0: all), each row of B summing
+        to 1)."""
+        if mode not in _lib.TRANSFER_MODES:
+            raise ValueError(f"mode must be one of {sorted(_lib.TRANSFER_MODES)}, got {mode!r}")
+        values = np.ascontiguousarray(values, dtype=np.float64)
+        if values.ndim not in (1, 2):
+            raise ValueError(f"values must be 1-D or 2-D, got shape {values.shape}")
+        channels = 1 if values.ndim == 1 else values.shape[1]
+        shape = (self.n_vertices_b,) if values.ndim == 1 else (self.n_vertices_b, channels)
+        out = np.empty(shape, dtype=np.float64)
+        _check(lib.sc_surface_map_transfer(
+            self, _ptr(values, ctypes.c_double), values.size, channels,
+            _lib.TRANSFER_MODES[mode], max_influences, _ptr(out, ctypes.c_double), out.size,
+        ))
+        return out
+
+    def __repr__(self):
+        return f"<shapecorr.SurfaceMap {self.n_vertices_b} vertices of B -> surface of A>"
+
+
+def surface_map(a, b, pointwise, progress=None):
+    """Where every vertex of B lands on A's surface, from ``pointwise`` (the
+    :class:`PointwiseMap` of ``a`` and ``b``): the vertex map smoothed over B's neighbours
+    and projected onto A's triangles. Carry data with :meth:`SurfaceMap.transfer`.
+    ``progress`` as for :func:`match` (stage ``"transfer"``)."""
+    _expect(a, Shape, "a"), _expect(b, Shape, "b"), _expect(pointwise, PointwiseMap, "pointwise")
+    return SurfaceMap(_Progress(progress).run(lib.sc_surface_map_new, a, b, pointwise))

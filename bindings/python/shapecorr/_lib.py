@@ -211,6 +211,14 @@ FUNCTIONS = {
     "sc_pointwise_seconds": (status, [handle, c_str, c_f64p]),
     "sc_pointwise_confidence": (ctypes.c_double, [handle]),
     "sc_pointwise_warning": (ctypes.c_char_p, [handle]),
+    # transfer
+    "sc_surface_map_new": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
+    "sc_surface_map_free": (None, [handle]),
+    "sc_surface_map_n_vertices": (c_size_t, [handle, u32_arg]),
+    "sc_surface_map_points": (status, [handle, c_u32p, c_f64p, c_size_t]),
+    "sc_surface_map_transfer": (
+        status, [handle, c_f64p, c_size_t, c_size_t, u32_arg, u32_arg, c_f64p, c_size_t],
+    ),
 }
 
 def _raising_the_original(function):
@@ -277,4 +285,7 @@ STAGE_NAMES = {
     6: "symmetry_breaking",
     7: "pointwise_map",
     8: "proxy",
+    9: "transfer",
 }
+#: Transfer modes (``SC_TRANSFER_*``).
+TRANSFER_MODES = {"interpolate": 0, "nearest": 1, "weights": 2}

@@ -529,3 +529,52 @@ def test_bad_repair_arguments_raise():
         shapecorr.Shape.point_cloud(points, repair={"glue"})
     cloud = shapecorr.Shape.point_cloud(np.vstack([points, [[1e3, 1e3, 1e3]]]), repair={"outliers"})
     assert any("far from" in w for w in cloud.warnings), cloud.warnings
+
+
+# ------------------------------------------------------------------------ transfer (issue 21)
+
+
+def test_transfer_modes_agree_with_the_surface_points(humanoids):
+    a, b = humanoids
+    pointwise = shapecorr.pointwise_map(a, b)
+    stages = []
+    onto = shapecorr.surface_map(a, b, pointwise, progress=lambda s, f: stages.append(s))
+    assert stages and set(stages) == {"transfer"}
+    assert (onto.n_vertices_a, onto.n_vertices_b) == (a.n_vertices, b.n_vertices)
+    corners, weights = onto.points
+    assert corners.shape == (b.n_vertices, 3) and corners.max() < a.n_vertices
+    assert np.allclose(weights.sum(axis=1), 1.0)
+    xyz = a.vertices
+    carried = onto.transfer(xyz)
+    assert carried.shape == (b.n_vertices, 3)
+    assert np.allclose(carried, np.einsum("vk,vkc->vc", weights, xyz[corners]))
+    labels = np.arange(a.n_vertices) % 5
+    assert np.array_equal(onto.transfer(labels, mode="nearest"), labels[corners[:, 0]])
+    skin = np.stack([xyz[:, 1] > 0, xyz[:, 1] <= 0], axis=1).astype(float) * 0.7 + 0.1
+    one = onto.transfer(skin, mode="weights", max_influences=1)
+    assert np.allclose(one.sum(axis=1), 1.0) and np.all((one > 0).sum(axis=1) == 1)
+
+
+def test_transfer_errors(humanoids):
+    a, b = humanoids
+    pointwise = shapecorr.pointwise_map(a, b)
+    onto = shapecorr.surface_map(a, b, pointwise)
+    with pytest.raises(ValueError, match="mode"):
+        onto.transfer(np.zeros(a.n_vertices), mode="cubic")
+    with pytest.raises(ShapecorrError, match="vertices"):
+        onto.transfer(np.zeros(a.n_vertices + 1))
+    bad = np.full((a.n_vertices, 2), 0.5)
+    bad[4, 1] = -1.0
+    with pytest.raises(ShapecorrError, match="vertex 4 channel 1"):
+        onto.transfer(bad, mode="weights")
+    bad[4, 1] = np.nan
+    with pytest.raises(ShapecorrError, match="finite"):
+        onto.transfer(bad)
+    with pytest.raises(TypeError):
+        shapecorr.surface_map(a, b, a)
+    other = shapecorr.Shape.figure("humanoid", 0, 1200)
+    with pytest.raises(ShapecorrError, match="vertices"):
+        shapecorr.surface_map(other, b, pointwise)
+    with pytest.raises(ShapecorrError) as cancelled:
+        shapecorr.surface_map(a, b, pointwise, progress=lambda s, f: False)
+    assert cancelled.value.status_name == "CANCELLED"
