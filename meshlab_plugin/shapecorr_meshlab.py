@@ -24,6 +24,15 @@ The command's options are generated from the library's option table
 option, named as the option with ``-`` for ``_`` (``--k-min 5``, ``--gap-ratio 0.85``,
 ``--one-to-one false``), plus ``--set NAME=VALUE`` (repeatable, the table's spelling,
 applied after them).
+
+Transfer (issue 21) carries A's vertex colours, quality and per-vertex texture coordinates
+to B through the correspondence, whatever their poses and bodies::
+
+    python meshlab_plugin/shapecorr_meshlab.py transfer A.ply B.ply --out B_from_A.ply
+    out, pointwise = shapecorr_meshlab.transfer(ms)    # a MeshSet with B carrying A's data
+
+(A file named ``transfer`` as the first mesh is spelt ``./transfer``.) Per-wedge texture
+coordinates are not carried yet.
 """
 
 import argparse
@@ -103,6 +112,37 @@ def match_with_shapes(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False,
     for mesh, side in ((mesh_a, "a"), (mesh_b, "b")):
         out.add_mesh(coloured(mesh, result.regions(side), result.colors(side, one_to_one=one_to_one)))
     return out, result, shapes
+
+
+def transfer(ms, id_a=0, id_b=1, colors=True, quality=True, texcoords=True, progress=None, **options):
+    """Carries per-vertex data of mesh ``id_a`` of the MeshSet ``ms`` to mesh ``id_b``
+    through the correspondence (any pose and body): vertex colours and texture coordinates
+    interpolated on A's surface, the vertex quality too. Returns ``(meshset, pointwise)``: a
+    new MeshSet holding a copy of B with what A has of these (``colors``, ``quality``,
+    ``texcoords`` say which), and the shapecorr.PointwiseMap (its ``confidence`` and
+    ``warning``: see :func:`report`). ``options`` as :func:`match_regions`'. Raises
+    shapecorr.ShapecorrError on bad input, ValueError when A has none of what is asked."""
+    mesh_a, mesh_b = ms.mesh(id_a), ms.mesh(id_b)
+    if len(mesh_a.face_matrix()) == 0 or len(mesh_b.face_matrix()) == 0:
+        raise ValueError("transfer needs two meshes with faces")
+    carried = {}
+    if colors and mesh_a.has_vertex_color():
+        carried["v_color_matrix"] = mesh_a.vertex_color_matrix()
+    if quality and mesh_a.has_vertex_scalar():
+        carried["v_scalar_array"] = mesh_a.vertex_scalar_array()
+    if texcoords and mesh_a.has_vertex_tex_coord():
+        carried["v_tex_coords_matrix"] = mesh_a.vertex_tex_coord_matrix()
+    if not carried:
+        raise ValueError("mesh A has none of what was asked (vertex colours, quality, texture coordinates)")
+    shapes = (shape_of(mesh_a), shape_of(mesh_b))
+    pointwise = shapecorr.pointwise_map(*shapes, progress=progress, **options)
+    onto = shapecorr.surface_map(*shapes, pointwise, progress=progress)
+    values = {name: onto.transfer(array) for name, array in carried.items()}
+    if "v_color_matrix" in values:
+        values["v_color_matrix"] = np.clip(values["v_color_matrix"], 0.0, 1.0)
+    out = pymeshlab.MeshSet()
+    out.add_mesh(pymeshlab.Mesh(vertex_matrix=mesh_b.vertex_matrix(), face_matrix=mesh_b.face_matrix(), **values))
+    return out, pointwise
 
 
 #: Text read as True and as False for a boolean option (as the command line reads them).
@@ -189,7 +229,57 @@ def options_of(args):
     return options
 
 
+def transfer_parser():
+    """The arguments of ``transfer`` (the options as the matching command's)."""
+    parser = argparse.ArgumentParser(
+        prog="shapecorr_meshlab.py transfer",
+        description="Carry vertex colours, quality and texture coordinates from mesh A to mesh B (shapecorr).",
+    )
+    parser.add_argument("a", help="source mesh (any format MeshLab reads)")
+    parser.add_argument("b", help="target mesh")
+    parser.add_argument("--out", required=True, help="B with A's data (e.g. B_from_A.ply)")
+    for name in ("colors", "quality", "texcoords"):
+        parser.add_argument(f"--no-{name}", action="store_true", help=f"do not carry the vertex {name}")
+    parser.add_argument(
+        "--set", dest="set", metavar="NAME=VALUE", action="append", default=[],
+        type=_set_parser(shapecorr.options()), help="a library option by its table name (k_max=8); repeatable",
+    )
+    return parser
+
+
+def main_transfer(argv):
+    args = transfer_parser().parse_args(argv)
+    ms = pymeshlab.MeshSet()
+    try:
+        ms.load_new_mesh(str(args.a))
+        ms.load_new_mesh(str(args.b))
+    except pymeshlab.PyMeshLabException as error:
+        print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
+        return 1
+    try:
+        out, pointwise = transfer(
+            ms, colors=not args.no_colors, quality=not args.no_quality, texcoords=not args.no_texcoords,
+            **dict(args.set),
+        )
+    except (shapecorr.ShapecorrError, ValueError) as error:
+        print(f"shapecorr_meshlab: {error}", file=sys.stderr)
+        return 1
+    mesh = out.current_mesh()
+    out.save_current_mesh(
+        str(args.out), save_vertex_color=mesh.has_vertex_color(), save_vertex_quality=mesh.has_vertex_scalar(),
+        save_vertex_coord=mesh.has_vertex_tex_coord(),
+    )
+    summary, *warnings = report(pointwise)
+    print(f"shapecorr_meshlab: wrote {args.out} ({summary})")
+    for line in warnings:
+        print(f"shapecorr_meshlab: {line}", file=sys.stderr)
+    return 0
+
+
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["transfer"]:
+        return main_transfer(argv[1:])
     args = argument_parser().parse_args(argv)
     options = options_of(args)
     one_to_one = options.pop("one_to_one", True) and not args.symmetric

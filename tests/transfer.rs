@@ -302,3 +302,150 @@ fn bad_values_are_refused_with_the_vertex_named() {
     wrong[0] = n as u32;
     assert!(SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &wrong).is_err());
 }
+
+/// A cylindrical unwrap about the vertical axis, per corner: u = the angle about the axis
+/// (0 to 1), v = the height (0 to 1). A triangle across the back (where the angle wraps)
+/// takes u + 1 at its corners below 0.5: the back is a seam.
+fn cylinder_uv(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<f64> {
+    let (low, high) = vertices
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p[1]), h.max(p[1])));
+    let uv = |p: &[f64; 3]| {
+        let u = p[0].atan2(p[2]) / std::f64::consts::TAU + 0.5;
+        [u, (p[1] - low) / (high - low)]
+    };
+    let mut out = Vec::with_capacity(faces.len() * 6);
+    for t in faces {
+        let corners = t.map(|v| uv(&vertices[v as usize]));
+        let wraps = corners.iter().any(|c| c[0] > 0.75) && corners.iter().any(|c| c[0] < 0.25);
+        for c in corners {
+            out.push(if wraps && c[0] < 0.5 {
+                c[0] + 1.0
+            } else {
+                c[0]
+            });
+            out.push(c[1]);
+        }
+    }
+    out
+}
+
+/// Islands of per-corner values (triangles sharing an edge whose corners agree), largest
+/// first, as face counts.
+fn island_sizes(faces: &[[u32; 3]], uv: &[f64]) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    let corner = |f: usize, i: usize| [uv[6 * f + 2 * i], uv[6 * f + 2 * i + 1]];
+    let mut edges = std::collections::HashMap::new();
+    for (f, t) in faces.iter().enumerate() {
+        for i in 0..3 {
+            let j = (i + 1) % 3;
+            let key = (t[i].min(t[j]), t[i].max(t[j]));
+            let ends = if t[i] < t[j] { (i, j) } else { (j, i) };
+            if let Some(&(g, gi, gj)) = edges.get(&key) {
+                let same = |p: [f64; 2], q: [f64; 2]| {
+                    (p[0] - q[0]).abs() < 1e-9 && (p[1] - q[1]).abs() < 1e-9
+                };
+                if same(corner(f, ends.0), corner(g, gi)) && same(corner(f, ends.1), corner(g, gj))
+                {
+                    let (x, y) = (find(&mut parent, f), find(&mut parent, g));
+                    parent[x] = y;
+                }
+            } else {
+                edges.insert(key, (f, ends.0, ends.1));
+            }
+        }
+    }
+    let mut sizes = std::collections::HashMap::new();
+    for f in 0..faces.len() {
+        *sizes.entry(find(&mut parent, f)).or_insert(0) += 1;
+    }
+    let mut sizes: Vec<usize> = sizes.into_values().collect();
+    sizes.sort_unstable_by(|x, y| y.cmp(x));
+    sizes
+}
+
+/// Triangles whose texture coordinates span more than half the texture in u: smeared
+/// across a seam.
+fn smeared(uv: &[f64]) -> usize {
+    uv.chunks_exact(6)
+        .filter(|t| {
+            let us = [t[0], t[2], t[4]];
+            us.iter().cloned().fold(f64::MIN, f64::max)
+                - us.iter().cloned().fold(f64::MAX, f64::min)
+                > 0.5
+        })
+        .count()
+}
+
+#[test]
+fn texture_coordinates_keep_their_seams() {
+    let p = pair(4000, 8000, 1);
+    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let (faces_a, faces_b) = (&p.rig_a.rest.triangles, &p.rig_b.rest.triangles);
+    let uv_a = cylinder_uv(&p.rig_a.rest.vertices, faces_a);
+    let truth = cylinder_uv(&p.rig_b.rest.vertices, faces_b);
+    let carried = map
+        .transfer_corners((&p.shape_a, faces_a), &uv_a, faces_b, 2)
+        .unwrap();
+    // Per vertex (the naive way): every corner takes its vertex's interpolated value.
+    let per_vertex_uv: Vec<f64> = {
+        let mut u_a = vec![0.0; 2 * p.shape_a.n_vertices()];
+        for (f, t) in faces_a.iter().enumerate() {
+            for i in 0..3 {
+                u_a[2 * t[i] as usize] = uv_a[6 * f + 2 * i].rem_euclid(1.0);
+                u_a[2 * t[i] as usize + 1] = uv_a[6 * f + 2 * i + 1];
+            }
+        }
+        let on_b = map.transfer(&u_a, 2, TransferMode::Interpolate).unwrap();
+        faces_b
+            .iter()
+            .flat_map(|t| {
+                t.iter()
+                    .flat_map(|&v| [on_b[2 * v as usize], on_b[2 * v as usize + 1]])
+            })
+            .collect()
+    };
+    // Error per corner, u compared around the cylinder.
+    let errors: Vec<f64> = carried
+        .chunks_exact(2)
+        .zip(truth.chunks_exact(2))
+        .map(|(c, t)| {
+            let du = (c[0] - t[0]).rem_euclid(1.0);
+            du.min(1.0 - du).hypot(c[1] - t[1])
+        })
+        .collect();
+    let (mean, _) = mean_max(&errors);
+    let (islands_a, islands_b) = (
+        island_sizes(faces_a, &uv_a),
+        island_sizes(faces_b, &carried),
+    );
+    let big = |sizes: &[usize], total: usize| sizes.iter().filter(|&&s| s * 100 >= total).count();
+    eprintln!(
+        "texture coordinates 4000 -> 8000: mean corner error {mean:.4}; islands A {:?}, B {:?} \
+         (first 5); triangles smeared across the seam: {} per corner, {} per vertex, of {}",
+        &islands_a[..islands_a.len().min(5)],
+        &islands_b[..islands_b.len().min(5)],
+        smeared(&carried),
+        smeared(&per_vertex_uv),
+        faces_b.len()
+    );
+    assert!(mean < 0.02, "mean corner error {mean}");
+    assert_eq!(smeared(&carried), 0, "no triangle spans the seam");
+    assert!(
+        smeared(&per_vertex_uv) > 0,
+        "the per-vertex way does smear (or the test shows nothing)"
+    );
+    // No island that A does not have: as many islands of at least 1% of the triangles.
+    assert_eq!(
+        big(&islands_b, faces_b.len()),
+        big(&islands_a, faces_a.len()),
+        "{islands_a:?} {islands_b:?}"
+    );
+}

@@ -132,8 +132,9 @@ def show_attribute_colors(context):
 class _Job:
     """A library call run in a thread: progress in, cancel flag out."""
 
-    def __init__(self, work):
+    def __init__(self, work, stages=_STAGES):
         self.work = work
+        self.stages = stages
         self.cancel = threading.Event()
         self.fraction = 0.0
         self.result = None
@@ -141,8 +142,8 @@ class _Job:
         self.thread = None
 
     def progress(self, stage, fraction):
-        index = _STAGES.index(stage) if stage in _STAGES else 0
-        self.fraction = max(self.fraction, (index + fraction) / len(_STAGES))
+        index = self.stages.index(stage) if stage in self.stages else 0
+        self.fraction = max(self.fraction, (index + fraction) / len(self.stages))
         return not self.cancel.is_set()
 
     def run(self):
@@ -163,6 +164,8 @@ class _LibraryOperator:
     bl_options = {"REGISTER", "UNDO"}
     #: How many selected meshes the operator works on.
     selection_size = 0
+    #: The library's stages the operator goes through, in order (for one progress value).
+    stages = _STAGES
     _timer = None
     _job = None
 
@@ -181,7 +184,7 @@ class _LibraryOperator:
             return {"CANCELLED"}
         wm = context.window_manager
         wm.progress_begin(0, 1000)
-        job = _Job(work)
+        job = _Job(work, self.stages)
 
         def progress(stage, fraction):
             keep_going = job.progress(stage, fraction)
@@ -205,7 +208,7 @@ class _LibraryOperator:
         except (ValueError, shapecorr.ShapecorrError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self._job = _Job(work)
+        self._job = _Job(work, self.stages)
         self._job.start()
         wm = context.window_manager
         wm.progress_begin(0, 1000)
@@ -246,7 +249,7 @@ class _LibraryOperator:
     def finish(self, context, result):
         try:
             message = self.apply(context, result)
-        except (ValueError, ReferenceError, KeyError) as error:
+        except (ValueError, ReferenceError, KeyError, RuntimeError, TypeError) as error:
             self.report({"ERROR"}, f"shapecorr: the result could not be written: {error}")
             return {"CANCELLED"}
         show_attribute_colors(context)

@@ -37,6 +37,54 @@ class ShapecorrSettings(bpy.types.PropertyGroup):
         default=False,
     )
 
+    transfer_vertex_groups: bpy.props.BoolProperty(
+        name="Vertex Groups",
+        description="Carry the source's vertex groups (skin weights) to the target",
+        default=True,
+    )
+    transfer_active_group_only: bpy.props.BoolProperty(
+        name="Active Group Only",
+        description="Carry only the source's active vertex group",
+        default=False,
+    )
+    transfer_normalize_weights: bpy.props.BoolProperty(
+        name="Normalize Weights",
+        description="Treat the vertex groups as skin weights: each target vertex's weights sum "
+        "to 1 (off: every group is interpolated on its own, for masks)",
+        default=True,
+    )
+    transfer_max_influences: bpy.props.IntProperty(
+        name="Max Influences",
+        description="Most vertex groups per target vertex, the largest kept (0: no limit; "
+        "used with Normalize Weights)",
+        default=4,
+        min=0,
+        max=64,
+    )
+    transfer_uvs: bpy.props.BoolProperty(
+        name="UV Maps",
+        description="Carry the source's UV maps per corner: a UV island stays one island, the "
+        "target's seam runs where the source's seam lands",
+        default=True,
+    )
+    transfer_colors: bpy.props.BoolProperty(
+        name="Colour Attributes",
+        description="Carry the source's colour attributes (a corner colour is averaged per vertex)",
+        default=True,
+    )
+    transfer_attributes: bpy.props.BoolProperty(
+        name="Point Attributes",
+        description="Carry the source's generic point attributes (float ones interpolated, "
+        "integer and boolean ones from the nearest vertex)",
+        default=True,
+    )
+    transfer_prefix: bpy.props.StringProperty(
+        name="Prefix",
+        description="Prefix of the names written on the target (empty: the source's names, "
+        "replacing the target's of the same name)",
+        default="",
+    )
+
     def library_options(self, one_to_one=None):
         """The options passed to shapecorr.match."""
         return {

@@ -328,3 +328,201 @@ def test_render_the_coloured_figures_with_cycles(addon, tmp_path):
     # The figures are coloured: many distinct saturated colours in the picture.
     saturated = pixels[(pixels[:, :3].max(axis=1) - pixels[:, :3].min(axis=1)) > 0.2]
     assert len(saturated) > 200
+
+
+# ------------------------------------------------------------------------ Transfer (issue 21)
+
+
+def library_surface_map(addon, a, b):
+    """The library's surface map on the world-space data the add-on reads from ``a``, ``b``."""
+    sc = addon.shapecorr
+    shapes = []
+    for obj in (a, b):
+        n = len(obj.data.vertices)
+        co = np.empty(3 * n, dtype=np.float32)
+        obj.data.vertices.foreach_get("co", co)
+        matrix = np.array(obj.matrix_world, dtype=np.float64)
+        world = co.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+        triangles = np.array([tuple(p.vertices) for p in obj.data.polygons], dtype=np.uint32)
+        shapes.append(sc.Shape.mesh(world, triangles))
+    pointwise = sc.pointwise_map(*shapes)
+    return sc.surface_map(shapes[0], shapes[1], pointwise), pointwise
+
+
+def library_shape_a(addon, a):
+    """The library's shape of ``a`` as the add-on reads it (world space, loop triangles)."""
+    n = len(a.data.vertices)
+    co = np.empty(3 * n, dtype=np.float32)
+    a.data.vertices.foreach_get("co", co)
+    matrix = np.array(a.matrix_world, dtype=np.float64)
+    world = co.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+    return addon.shapecorr.Shape.mesh(world, loop_triangles(a)[0])
+
+
+def group_weights(obj, name):
+    group = obj.vertex_groups[name]
+    weights = np.zeros(len(obj.data.vertices))
+    for vertex in obj.data.vertices:
+        for element in vertex.groups:
+            if element.group == group.index:
+                weights[vertex.index] = element.weight
+    return weights
+
+
+def rigged_source(addon):
+    """A in the rest pose with two skin-weight groups, a mask, a colour and two point
+    attributes; B posed, moved and turned, with nothing."""
+    fresh_scene()
+    (va, ta), (vb, tb) = figures(addon)
+    a = add_object("Source", va, ta)
+    b = add_object("Target", vb, tb, location=(3.0, 0.0, 0.0), rotation_z=0.7)
+    height = va[:, 1]
+    upper = np.clip((height - height.min()) / np.ptp(height), 0.0, 1.0)
+    for name, weights in (("upper", upper), ("lower", 1.0 - upper), ("mask", upper > 0.8)):
+        group = a.vertex_groups.new(name=name)
+        for vertex in np.flatnonzero(weights > 0):
+            group.add([int(vertex)], float(weights[vertex]), "REPLACE")
+    mesh = a.data
+    colors = mesh.color_attributes.new("paint", "FLOAT_COLOR", "POINT")
+    rgba = np.stack([upper, 1.0 - upper, np.full_like(upper, 0.5), np.ones_like(upper)], axis=1)
+    colors.data.foreach_set("color", rgba.astype(np.float32).ravel())
+    mesh.attributes.new("heat", "FLOAT", "POINT").data.foreach_set("value", upper.astype(np.float32))
+    labels = (va[:, 0] > 0).astype(np.int32) + 2 * (va[:, 1] > np.median(va[:, 1]))
+    mesh.attributes.new("part", "INT", "POINT").data.foreach_set("value", labels)
+    add_cylinder_uv(a)
+    select(a, b)
+    return a, b, upper, labels
+
+
+def add_cylinder_uv(obj):
+    """A UV map "cylinder": u the angle about the vertical axis, v the height; a face
+    across the back takes u + 1 at its corners below 0.5 (the back is a seam)."""
+    mesh = obj.data
+    mesh.uv_layers.new(name="cylinder")
+    xyz = np.empty(3 * len(mesh.vertices), dtype=np.float32)
+    mesh.vertices.foreach_get("co", xyz)
+    xyz = xyz.reshape(-1, 3).astype(np.float64)
+    corner_vertex = np.empty(len(mesh.loops), dtype=np.int32)
+    mesh.loops.foreach_get("vertex_index", corner_vertex)
+    u = np.arctan2(xyz[:, 0], xyz[:, 2]) / (2 * np.pi) + 0.5
+    v = (xyz[:, 1] - xyz[:, 1].min()) / np.ptp(xyz[:, 1])
+    uv = np.stack([u[corner_vertex], v[corner_vertex]], axis=1)
+    for polygon in mesh.polygons:
+        loops = np.arange(polygon.loop_start, polygon.loop_start + polygon.loop_total)
+        if uv[loops, 0].max() > 0.75 and uv[loops, 0].min() < 0.25:
+            uv[loops[uv[loops, 0] < 0.5], 0] += 1.0
+    mesh.attributes["cylinder"].data.foreach_set("vector", uv.astype(np.float32).ravel())
+
+
+def loop_uv(obj, name):
+    mesh = obj.data
+    uv = np.empty(2 * len(mesh.loops), dtype=np.float32)
+    mesh.attributes[name].data.foreach_get("vector", uv)
+    return uv.reshape(-1, 2).astype(np.float64)
+
+
+def loop_triangles(obj):
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    n = len(mesh.loop_triangles)
+    vertices, loops = np.empty(3 * n, dtype=np.int32), np.empty(3 * n, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", vertices)
+    mesh.loop_triangles.foreach_get("loops", loops)
+    return vertices.reshape(n, 3), loops.reshape(n, 3)
+
+
+def test_transfer_carries_groups_colours_and_attributes_like_the_library(addon):
+    a, b, upper, labels = rigged_source(addon)
+    settings = bpy.context.scene.shapecorr
+    settings.transfer_max_influences = 4
+    assert bpy.ops.shapecorr.transfer.poll()
+    assert bpy.ops.shapecorr.transfer() == {"FINISHED"}
+    onto, pointwise = library_surface_map(addon, a, b)
+    stored = lambda w: w.astype(np.float32).astype(np.float64)  # noqa: E731 - Blender keeps float32
+    # Skin weights: normalised together, as the library carries them.
+    source = np.stack([group_weights(a, n) for n in ("upper", "lower", "mask")], axis=1)
+    expected = onto.transfer(source, mode="weights", max_influences=4)
+    got = np.stack([group_weights(b, n) for n in ("upper", "lower", "mask")], axis=1)
+    assert np.allclose(got, stored(expected), atol=1e-6)
+    assert np.allclose(got.sum(axis=1), 1.0, atol=1e-5)
+    # Colour and float attribute interpolated, integer attribute from the nearest vertex.
+    n = len(b.data.vertices)
+    rgba = np.empty(4 * n, dtype=np.float32)
+    b.data.color_attributes["paint"].data.foreach_get("color", rgba)
+    source_rgba = np.empty(4 * len(a.data.vertices), dtype=np.float32)
+    a.data.color_attributes["paint"].data.foreach_get("color", source_rgba)
+    expected = onto.transfer(source_rgba.reshape(-1, 4).astype(np.float64))
+    assert np.allclose(rgba.reshape(n, 4), expected, atol=1e-6)
+    heat = np.empty(n, dtype=np.float32)
+    b.data.attributes["heat"].data.foreach_get("value", heat)
+    assert np.allclose(heat, onto.transfer(stored(upper)), atol=1e-6)
+    part = np.empty(n, dtype=np.int32)
+    b.data.attributes["part"].data.foreach_get("value", part)
+    assert np.array_equal(part, onto.transfer(labels, mode="nearest").astype(np.int32))
+    # The figures share their vertex order: a right map carries most labels to their own
+    # vertices.
+    assert np.mean(part == labels) > 0.9
+    assert pointwise.confidence is not None
+    # The UV map per corner, as the library carries it, with no triangle across the seam.
+    faces_a, loops_a = loop_triangles(a)
+    faces_b, loops_b = loop_triangles(b)
+    expected = onto.transfer_corners(library_shape_a(addon, a), faces_a, loop_uv(a, "cylinder")[loops_a], faces_b)
+    got = loop_uv(b, "cylinder")[loops_b]
+    assert np.allclose(got, expected, atol=1e-6)
+    assert np.all(np.ptp(got[:, :, 0], axis=1) < 0.5)
+
+
+def test_transfer_prefix_active_group_and_plain_interpolation(addon):
+    a, b, upper, _ = rigged_source(addon)
+    settings = bpy.context.scene.shapecorr
+    settings.transfer_prefix = "from_source_"
+    settings.transfer_active_group_only = True
+    settings.transfer_normalize_weights = False
+    settings.transfer_colors = False
+    settings.transfer_attributes = False
+    settings.transfer_uvs = False
+    a.vertex_groups.active_index = a.vertex_groups["mask"].index
+    try:
+        assert bpy.ops.shapecorr.transfer() == {"FINISHED"}
+    finally:
+        settings.transfer_prefix = ""
+        settings.transfer_active_group_only = False
+        settings.transfer_normalize_weights = True
+        settings.transfer_colors = True
+        settings.transfer_attributes = True
+        settings.transfer_uvs = True
+    assert [g.name for g in b.vertex_groups] == ["from_source_mask"]
+    assert len(b.data.uv_layers) == 0
+    assert "paint" not in b.data.color_attributes and "heat" not in b.data.attributes
+    onto, _ = library_surface_map(addon, a, b)
+    expected = onto.transfer(group_weights(a, "mask"))
+    assert np.allclose(group_weights(b, "from_source_mask"), expected, atol=1e-6)
+
+
+@pytest.mark.parametrize("case, message", [("no_faces", "has no faces"), ("nan", "NON_FINITE_COORDINATE")])
+def test_transfer_to_a_bad_target_writes_nothing(addon, case, message):
+    a, b, _, _ = rigged_source(addon)
+    (_, _), (vb, tb) = figures(addon)
+    if case == "no_faces":
+        bad = add_object("Bad", vb, [])
+    else:
+        vertices = vb.copy()
+        vertices[3, 2] = np.nan
+        bad = add_object("Bad", vertices, tb)
+    select(a, bad)
+    with pytest.raises(RuntimeError, match=message):
+        bpy.ops.shapecorr.transfer()
+    assert len(bad.vertex_groups) == 0
+    assert len(bad.data.color_attributes) == 0
+    assert len(bad.data.uv_layers) == 0
+    assert "heat" not in bad.data.attributes
+
+
+def test_transfer_with_nothing_to_carry_says_so(addon):
+    fresh_scene()
+    (va, ta), (vb, tb) = figures(addon)
+    a = add_object("Plain", va, ta)
+    b = add_object("Other", vb, tb)
+    select(a, b)
+    with pytest.raises(RuntimeError, match="nothing of what"):
+        bpy.ops.shapecorr.transfer()

@@ -175,3 +175,60 @@ def test_the_repairs_made_are_reported(tmp_path):
     )
     assert run.returncode == 0, run.stderr
     assert "shapecorr_meshlab: repaired B: 1 vertices far from" in run.stderr, run.stderr
+
+
+# ------------------------------------------------------------------------ transfer (issue 21)
+
+
+def painted_pair():
+    """A in the rest pose with colours, quality and texture coordinates from its position; B
+    posed with nothing."""
+    a = shapecorr.Shape.figure("humanoid", 0, 2500)
+    b = shapecorr.Shape.figure("humanoid", 3, 2500)
+    xyz = a.vertices
+    t = (xyz - xyz.min(axis=0)) / np.ptp(xyz, axis=0)
+    colours = np.concatenate([t, np.ones((len(t), 1))], axis=1)
+    mesh_a = pymeshlab.Mesh(
+        vertex_matrix=xyz, face_matrix=a.triangles.astype(np.int32), v_color_matrix=colours,
+        v_scalar_array=t[:, 1], v_tex_coords_matrix=t[:, :2],
+    )
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(mesh_a)
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=b.vertices, face_matrix=b.triangles.astype(np.int32)))
+    return ms, a, b, colours, t
+
+
+def test_transfer_function_carries_colours_quality_and_texcoords_like_the_library():
+    ms, a, b, colours, t = painted_pair()
+    out, pointwise = shapecorr_meshlab.transfer(ms)
+    shape_a, shape_b = shapecorr_meshlab.shape_of(ms.mesh(0)), shapecorr_meshlab.shape_of(ms.mesh(1))
+    onto = shapecorr.surface_map(shape_a, shape_b, shapecorr.pointwise_map(shape_a, shape_b))
+    mesh = out.mesh(0)
+    assert np.array_equal(mesh.vertex_matrix(), ms.mesh(1).vertex_matrix())
+    assert np.allclose(mesh.vertex_color_matrix(), onto.transfer(colours), atol=1e-6)
+    assert np.allclose(mesh.vertex_scalar_array(), onto.transfer(t[:, 1]), atol=1e-9)
+    assert np.allclose(mesh.vertex_tex_coord_matrix(), onto.transfer(t[:, :2]), atol=1e-6)
+    # The figures share their vertex order: a right map carries the texture coordinates to
+    # within a few hundredths of their own.
+    assert np.median(np.abs(mesh.vertex_tex_coord_matrix() - t[:, :2])) < 0.02
+    assert pointwise.confidence is not None
+
+
+def test_transfer_command_writes_b_with_a_colours(tmp_path):
+    ms, _, _, _, _ = painted_pair()
+    for mesh_id, name in ((0, "a.ply"), (1, "b.ply")):
+        ms.set_current_mesh(mesh_id)
+        ms.save_current_mesh(str(tmp_path / name), save_vertex_color=True, save_vertex_quality=True)
+    out = tmp_path / "b_from_a.ply"
+    done = run_script("transfer", tmp_path / "a.ply", tmp_path / "b.ply", "--out", out, "--no-texcoords")
+    assert done.returncode == 0, done.stderr
+    assert "confidence" in done.stdout
+    loaded = pymeshlab.MeshSet()
+    loaded.load_new_mesh(str(out))
+    assert loaded.current_mesh().has_vertex_color()
+    # Nothing to carry, or no faces: a reason and exit 1.
+    plain = pymeshlab.MeshSet()
+    plain.add_mesh(pymeshlab.Mesh(vertex_matrix=ms.mesh(1).vertex_matrix(), face_matrix=ms.mesh(1).face_matrix()))
+    plain.save_current_mesh(str(tmp_path / "plain.ply"), save_vertex_color=False, save_vertex_quality=False)
+    done = run_script("transfer", tmp_path / "plain.ply", tmp_path / "b.ply", "--out", out)
+    assert done.returncode == 1 and "none of what" in done.stderr, done.stderr

@@ -154,6 +154,58 @@ pub unsafe extern "C" fn sc_surface_map_transfer(
     })
 }
 
+/// Carries per-corner values of A's triangles (texture coordinates) to the corners of B's
+/// triangles, seams kept: a triangle of B never spans two of A's islands (see the Rust
+/// `SurfaceMap::transfer_corners`). `faces_a` (`faces_a_len` = 3 x A's triangles, vertex
+/// indices of `a`) must be the triangles `a` was made from; `corner_values_a` holds
+/// `channels` values per corner of each, row-major (`n_values` = `faces_a_len` x
+/// `channels`); `faces_b` (`faces_b_len` = 3 x B's triangles) index B's vertices; the
+/// result, `channels` values per corner of B's triangles, goes to `out_values_b` of `len` =
+/// `faces_b_len` x `channels` elements.
+///
+/// Errors: `SC_STATUS_INVALID_ARGUMENT` for a face length that is not a multiple of 3;
+/// `SC_STATUS_INVALID_PARAMETER` for sizes that do not fit, vertex indices out of range or
+/// values that are not finite; `SC_STATUS_BUFFER_TOO_SMALL`.
+///
+/// # Safety
+/// `map` and `a` must be live; each input must point to its length of readable elements and
+/// `out_values_b` to `len` writable ones.
+#[no_mangle]
+pub unsafe extern "C" fn sc_surface_map_transfer_corners(
+    map: *const ScSurfaceMap,
+    a: *const ScShape,
+    faces_a: *const u32,
+    faces_a_len: usize,
+    corner_values_a: *const f64,
+    n_values: usize,
+    faces_b: *const u32,
+    faces_b_len: usize,
+    channels: usize,
+    out_values_b: *mut f64,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let map = &handle(map, "map")?.map;
+        let a = &handle(a, "a")?.shape;
+        let faces_a = triangles(input_slice(faces_a, faces_a_len, "faces_a")?, "faces_a")?;
+        let faces_b = triangles(input_slice(faces_b, faces_b_len, "faces_b")?, "faces_b")?;
+        let values = input_slice(corner_values_a, n_values, "corner_values_a")?;
+        let out = map.transfer_corners((a, &faces_a), values, &faces_b, channels)?;
+        write_output(out_values_b, len, &out, "out_values_b")
+    })
+}
+
+/// Flat vertex indices as triangles.
+fn triangles(flat: &[u32], name: &str) -> FfiResult<Vec<[u32; 3]>> {
+    if flat.len() % 3 != 0 {
+        return Err(Failure::invalid(format!(
+            "`{name}` has {} indices, not a multiple of 3",
+            flat.len()
+        )));
+    }
+    Ok(flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
+}
+
 fn transfer_mode(mode: u32, max_influences: u32) -> FfiResult<TransferMode> {
     match mode {
         SC_TRANSFER_INTERPOLATE => Ok(TransferMode::Interpolate),

@@ -1139,6 +1139,31 @@ static void test_transfer(void) {
     CHECK_STATUS(sc_surface_map_transfer(m, NULL, na, 1, SC_TRANSFER_INTERPOLATE, 0, out, nb),
                  SC_STATUS_NULL_ARGUMENT);
     CHECK(out[0] == -7.0, "output untouched by failed calls");
+    /* Per-corner values: a constant per triangle corner carries to the same constant. */
+    {
+        size_t nta = sc_shape_n_triangles(a), ntb = sc_shape_n_triangles(b);
+        uint32_t *faces_a = malloc(3 * nta * sizeof *faces_a), *faces_b = malloc(3 * ntb * sizeof *faces_b);
+        double *corner_a = malloc(3 * nta * sizeof *corner_a), *corner_b = malloc(3 * ntb * sizeof *corner_b);
+        CHECK_STATUS(sc_shape_triangles(a, faces_a, 3 * nta), SC_STATUS_OK);
+        CHECK_STATUS(sc_shape_triangles(b, faces_b, 3 * ntb), SC_STATUS_OK);
+        for (i = 0; i < 3 * nta; i++)
+            corner_a[i] = 0.25;
+        CHECK_STATUS(sc_surface_map_transfer_corners(m, a, faces_a, 3 * nta, corner_a, 3 * nta, faces_b,
+                                                     3 * ntb, 1, corner_b, 3 * ntb),
+                     SC_STATUS_OK);
+        for (i = 0; i < 3 * ntb; i++)
+            CHECK(fabs(corner_b[i] - 0.25) < 1e-12, "corner %zu: %g", i, corner_b[i]);
+        CHECK_STATUS(sc_surface_map_transfer_corners(m, a, faces_a, 3 * nta - 1, corner_a, 3 * nta,
+                                                     faces_b, 3 * ntb, 1, corner_b, 3 * ntb),
+                     SC_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(sc_surface_map_transfer_corners(m, a, faces_a, 3 * nta, corner_a, 3 * nta - 3,
+                                                     faces_b, 3 * ntb, 1, corner_b, 3 * ntb),
+                     SC_STATUS_INVALID_PARAMETER);
+        free(faces_a);
+        free(faces_b);
+        free(corner_a);
+        free(corner_b);
+    }
     free(xyz_a);
     free(x_a);
     free(out);

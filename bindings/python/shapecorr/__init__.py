@@ -691,6 +691,29 @@ class SurfaceMap(_Handle):
         ))
         return out
 
+    def transfer_corners(self, a, faces_a, corner_values, faces_b):
+        """Per-corner values of A's triangles ``faces_a`` (``(n_a_triangles, 3)`` vertex
+        indices of shape ``a``, the triangles it was made from) carried to the corners of
+        B's triangles ``faces_b``, seams kept (texture coordinates: a UV island of A stays
+        one island on B, no triangle of B spans A's seam). ``corner_values`` is
+        ``(n_a_triangles, 3)`` or ``(n_a_triangles, 3, channels)``; the result is float64,
+        ``(n_b_triangles, 3)`` or ``(n_b_triangles, 3, channels)``."""
+        _expect(a, Shape, "a")
+        faces_a = np.ascontiguousarray(faces_a, dtype=np.uint32)
+        faces_b = np.ascontiguousarray(faces_b, dtype=np.uint32)
+        values = np.ascontiguousarray(corner_values, dtype=np.float64)
+        if values.ndim not in (2, 3) or values.shape[:2] != (len(faces_a), 3):
+            raise ValueError(f"corner_values must be ({len(faces_a)}, 3[, channels]), got {values.shape}")
+        channels = 1 if values.ndim == 2 else values.shape[2]
+        shape = (len(faces_b), 3) if values.ndim == 2 else (len(faces_b), 3, channels)
+        out = np.empty(shape, dtype=np.float64)
+        _check(lib.sc_surface_map_transfer_corners(
+            self, a, _ptr(faces_a, ctypes.c_uint32), faces_a.size, _ptr(values, ctypes.c_double),
+            values.size, _ptr(faces_b, ctypes.c_uint32), faces_b.size, channels,
+            _ptr(out, ctypes.c_double), out.size,
+        ))
+        return out
+
     def __repr__(self):
         return f"<shapecorr.SurfaceMap {self.n_vertices_b} vertices of B -> surface of A>"
 

@@ -219,6 +219,10 @@ FUNCTIONS = {
     "sc_surface_map_transfer": (
         status, [handle, c_f64p, c_size_t, c_size_t, u32_arg, u32_arg, c_f64p, c_size_t],
     ),
+    "sc_surface_map_transfer_corners": (
+        status,
+        [handle, handle, c_u32p, c_size_t, c_f64p, c_size_t, c_u32p, c_size_t, c_size_t, c_f64p, c_size_t],
+    ),
 }
 
 def _raising_the_original(function):

@@ -140,8 +140,17 @@ def test_none_and_truthy_returns_go_on(pair):
     shapecorr.match(a, b, verify_hypotheses=False, progress=lambda s, f: np.True_)
 
 
+@pytest.fixture
+def python_ctrl_c():
+    """Python's own Ctrl-C handler for the test: a process started in the background by a
+    shell without job control inherits SIGINT ignored, and Python then installs none."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 @pytest.mark.parametrize("with_callback", [True, False])
-def test_ctrl_c_during_a_call_cancels_and_raises_keyboard_interrupt(with_callback):
+def test_ctrl_c_during_a_call_cancels_and_raises_keyboard_interrupt(with_callback, python_ctrl_c):
     a = shapecorr.Shape.figure("humanoid", 0, 3000)
     b = shapecorr.Shape.figure("humanoid", 3, 3000)
     progress = (lambda stage, fraction: True) if with_callback else None

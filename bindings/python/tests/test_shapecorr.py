@@ -578,3 +578,38 @@ def test_transfer_errors(humanoids):
     with pytest.raises(ShapecorrError) as cancelled:
         shapecorr.surface_map(a, b, pointwise, progress=lambda s, f: False)
     assert cancelled.value.status_name == "CANCELLED"
+
+
+def cylinder_corners(vertices, triangles):
+    """Per-corner (u, v): u the angle about the vertical axis, v the height; a triangle across
+    the back takes u + 1 at its corners below 0.5."""
+    u = np.arctan2(vertices[:, 0], vertices[:, 2]) / (2 * np.pi) + 0.5
+    v = (vertices[:, 1] - vertices[:, 1].min()) / np.ptp(vertices[:, 1])
+    uv = np.stack([u[triangles], v[triangles]], axis=2)
+    wraps = (uv[:, :, 0].max(axis=1) > 0.75) & (uv[:, :, 0].min(axis=1) < 0.25)
+    uv[:, :, 0] += wraps[:, None] & (uv[:, :, 0] < 0.5)
+    return uv
+
+
+def test_transfer_corners_keeps_the_seam(humanoids):
+    a, b = humanoids
+    onto = shapecorr.surface_map(a, b, shapecorr.pointwise_map(a, b))
+    uv_a = cylinder_corners(a.vertices, a.triangles)
+    carried = onto.transfer_corners(a, a.triangles, uv_a, b.triangles)
+    assert carried.shape == (len(b.triangles), 3, 2)
+    # No triangle of B spans the seam; the figures share their vertex order, so most corners
+    # land near their own coordinates.
+    assert np.all(np.ptp(carried[:, :, 0], axis=1) < 0.5)
+    truth = cylinder_corners(b.vertices, b.triangles)
+    du = np.abs(carried[:, :, 0] - truth[:, :, 0]) % 1.0
+    assert np.median(np.minimum(du, 1 - du)) < 0.02
+    one = onto.transfer_corners(a, a.triangles, uv_a[:, :, 0], b.triangles)
+    assert one.shape == (len(b.triangles), 3)
+    with pytest.raises(ValueError, match="corner_values"):
+        onto.transfer_corners(a, a.triangles, uv_a[:-1], b.triangles)
+    bad = uv_a.copy()
+    bad[2, 1, 0] = np.inf
+    with pytest.raises(ShapecorrError, match="triangle 2 corner 1 channel 0"):
+        onto.transfer_corners(a, a.triangles, bad, b.triangles)
+    with pytest.raises(ShapecorrError, match="faces_b"):
+        onto.transfer_corners(a, a.triangles, uv_a, b.triangles + b.n_vertices)

@@ -1,6 +1,9 @@
 //! Carrying per-vertex data from A to B through a [`SurfaceMap`] (issue 21): continuous
 //! values interpolated, labels taken from the nearest vertex, skin weights interpolated and
-//! renormalised.
+//! renormalised; per-corner data (texture coordinates) with its seams
+//! ([`SurfaceMap::transfer_corners`]).
+
+mod corners;
 
 use crate::maps::surface::SurfaceMap;
 use crate::{Error, Result};
