@@ -848,6 +848,34 @@ sc_status sc_surface_map_transfer(const sc_surface_map *map,
                                   double *out_values_b,
                                   size_t len);
 
+// Carries per-corner values of A's triangles (texture coordinates) to the corners of B's
+// triangles, seams kept: a triangle of B never spans two of A's islands (see the Rust
+// `SurfaceMap::transfer_corners`). `faces_a` (`faces_a_len` = 3 x A's triangles, vertex
+// indices of `a`) must be the triangles `a` was made from; `corner_values_a` holds
+// `channels` values per corner of each, row-major (`n_values` = `faces_a_len` x
+// `channels`); `faces_b` (`faces_b_len` = 3 x B's triangles) index B's vertices; the
+// result, `channels` values per corner of B's triangles, goes to `out_values_b` of `len` =
+// `faces_b_len` x `channels` elements.
+//
+// Errors: `SC_STATUS_INVALID_ARGUMENT` for a face length that is not a multiple of 3;
+// `SC_STATUS_INVALID_PARAMETER` for sizes that do not fit, vertex indices out of range or
+// values that are not finite; `SC_STATUS_BUFFER_TOO_SMALL`.
+//
+// # Safety
+// `map` and `a` must be live; each input must point to its length of readable elements and
+// `out_values_b` to `len` writable ones.
+sc_status sc_surface_map_transfer_corners(const sc_surface_map *map,
+                                          const sc_shape *a,
+                                          const uint32_t *faces_a,
+                                          size_t faces_a_len,
+                                          const double *corner_values_a,
+                                          size_t n_values,
+                                          const uint32_t *faces_b,
+                                          size_t faces_b_len,
+                                          size_t channels,
+                                          double *out_values_b,
+                                          size_t len);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

@@ -463,13 +463,12 @@ def test_transfer_carries_groups_colours_and_attributes_like_the_library(addon):
     # vertices.
     assert np.mean(part == labels) > 0.9
     assert pointwise.confidence is not None
-    # The UV map per corner, as the library carries it, with no triangle across the seam.
+    # The UV map per corner, as the library carries it (tests/transfer.rs checks the seams).
     faces_a, loops_a = loop_triangles(a)
     faces_b, loops_b = loop_triangles(b)
     expected = onto.transfer_corners(library_shape_a(addon, a), faces_a, loop_uv(a, "cylinder")[loops_a], faces_b)
     got = loop_uv(b, "cylinder")[loops_b]
     assert np.allclose(got, expected, atol=1e-6)
-    assert np.all(np.ptp(got[:, :, 0], axis=1) < 0.5)
 
 
 def test_transfer_prefix_active_group_and_plain_interpolation(addon):

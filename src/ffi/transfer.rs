@@ -197,7 +197,7 @@ pub unsafe extern "C" fn sc_surface_map_transfer_corners(
 
 /// Flat vertex indices as triangles.
 fn triangles(flat: &[u32], name: &str) -> FfiResult<Vec<[u32; 3]>> {
-    if flat.len() % 3 != 0 {
+    if !flat.len().is_multiple_of(3) {
         return Err(Failure::invalid(format!(
             "`{name}` has {} indices, not a multiple of 3",
             flat.len()

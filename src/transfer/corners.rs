@@ -1,33 +1,40 @@
 //! Per-corner data (texture coordinates) carried from A's triangles to B's, seams kept
 //! (issue 21).
 //!
-//! A's triangles fall into islands: two triangles sharing an edge are in one island when
-//! their corners on that edge carry the same values (a UV seam is an edge where they do
-//! not). Every corner of B is located on A by the [`SurfaceMap`] (a triangle of A and
-//! weights) and takes the weighted corner values of that triangle. A triangle of B whose
-//! corners land in different islands straddles A's seam: all its corners are put in the
-//! island most of them landed in (the first corner's on a tie), the others re-located on
-//! that island's triangles around their own landing triangle (the closest point in space).
-//! So B's seam runs along B's edges nearest A's seam, and no triangle of B spans two
-//! islands (which would smear it across the texture).
+//! A seam of A is an edge whose two triangles carry different values at its corners. Every
+//! corner of B is located on A by the [`SurfaceMap`] (a triangle of A and weights) and takes
+//! the weighted corner values of that triangle. Within one triangle of B all three corners
+//! must read one chart of A: from the triangle one corner landed in, A's triangles are
+//! walked across edges that are no seam, up to [`CHART_STEPS`] steps; a corner that landed
+//! outside that walk (across a seam) is re-located to the closest point of the walked
+//! triangles. The corner whose walk reaches most of the others leads (the first on a tie).
+//! So B's seam runs along B's edges nearest A's seam, and no triangle of B spans a seam
+//! (which would smear it across the texture).
 
 use std::collections::HashMap;
 
 use crate::maps::surface::SurfaceMap;
 use crate::shape::surface_point::closest_on_triangle;
-use crate::shape::{DisjointSets, Shape};
+use crate::shape::Shape;
 use crate::{Error, Result};
 
 /// Corner values closer than this are the same value (an edge between them is no seam).
 const SAME_VALUE: f64 = 1e-6;
 
-/// A's triangles as the caller gave them, with their corner values and islands.
-struct Islands<'a> {
+/// Most steps across A's edges walked from a triangle of B's leading corner to find its
+/// other corners' triangles in the same chart. Not tuned: a triangle of B as coarse as four
+/// of A's rings is still read in one chart; a coarser one is clamped to them.
+const CHART_STEPS: usize = 8;
+
+/// A's triangles as the caller gave them, with their corner values and the edges that are
+/// no seam.
+struct Charts<'a> {
     a: &'a Shape,
     faces: &'a [[u32; 3]],
     values: &'a [f64],
     channels: usize,
-    island: Vec<usize>,
+    /// For every triangle, its neighbours across edges that are no seam.
+    smooth_neighbors: Vec<Vec<u32>>,
     /// A's triangles by the sorted representatives of their corners.
     by_corners: HashMap<[u32; 3], u32>,
     /// A's triangles around every representative vertex.
@@ -56,25 +63,15 @@ impl SurfaceMap {
         channels: usize,
     ) -> Result<Vec<f64>> {
         check(self, (a, faces_a), corner_values_a, faces_b, channels)?;
-        let islands = Islands::new(a, faces_a, corner_values_a, channels);
+        let charts = Charts::new(a, faces_a, corner_values_a, channels);
         let mut out = Vec::with_capacity(faces_b.len() * 3 * channels);
         for face in faces_b {
-            let mut landings = face.map(|v| islands.landing(self, v as usize));
-            let island_of = landings.map(|l| l.map(|l| islands.island[l.face as usize]));
-            if let Some(chosen) = majority(island_of) {
-                for (landing, island) in landings.iter_mut().zip(island_of) {
-                    if let (Some(l), Some(i)) = (landing.as_mut(), island) {
-                        if i != chosen {
-                            *l = islands.relocated(*l, chosen);
-                        }
-                    }
-                }
-            }
-            for (corner, landing) in face.iter().zip(landings) {
+            let landings = face.map(|v| charts.landing(self, v as usize));
+            for (corner, landing) in face.iter().zip(charts.in_one_chart(landings)) {
                 match landing {
-                    Some(l) => out.extend(islands.value_at(l)),
+                    Some(l) => out.extend(charts.value_at(l)),
                     // A point of A on no triangle of `faces_a`: its vertex's first corner.
-                    None => out.extend(islands.value_of_vertex(self, *corner as usize)),
+                    None => out.extend(charts.value_of_vertex(self, *corner as usize)),
                 }
             }
         }
@@ -82,13 +79,13 @@ impl SurfaceMap {
     }
 }
 
-impl<'a> Islands<'a> {
+impl<'a> Charts<'a> {
     fn new(a: &'a Shape, faces: &'a [[u32; 3]], values: &'a [f64], channels: usize) -> Self {
         let representative = a.representative();
         let rep = |v: u32| representative[v as usize];
         let corner = |f: usize, i: usize| &values[(3 * f + i) * channels..][..channels];
         let same = |x: &[f64], y: &[f64]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= SAME_VALUE);
-        let mut sets = DisjointSets::new(faces.len());
+        let mut smooth_neighbors = vec![Vec::new(); faces.len()];
         let mut edges: HashMap<(u32, u32), (usize, usize, usize)> = HashMap::new();
         let mut by_corners = HashMap::new();
         let mut around = vec![Vec::new(); a.n_vertices()];
@@ -108,7 +105,8 @@ impl<'a> Islands<'a> {
                         if same(corner(f, small), corner(g, g_small))
                             && same(corner(f, large), corner(g, g_large))
                         {
-                            sets.union(f, g);
+                            smooth_neighbors[f].push(g as u32);
+                            smooth_neighbors[g].push(f as u32);
                         }
                     }
                     None => {
@@ -117,13 +115,12 @@ impl<'a> Islands<'a> {
                 }
             }
         }
-        let island = (0..faces.len()).map(|f| sets.find(f)).collect();
-        Islands {
+        Charts {
             a,
             faces,
             values,
             channels,
-            island,
+            smooth_neighbors,
             by_corners,
             around,
         }
@@ -145,28 +142,76 @@ impl<'a> Islands<'a> {
         Some(Landing { face, weights })
     }
 
-    /// `landing` moved to the closest point of island `island`'s triangles around its own
-    /// triangle's corners (unchanged when there is none).
-    fn relocated(&self, landing: Landing, island: usize) -> Landing {
+    /// The triangles reached from `start` in at most [`CHART_STEPS`] steps across edges
+    /// that are no seam, `start` first; the walk ends early once every one of `targets` is
+    /// reached (the usual case: a triangle of B lands on one or two neighbouring triangles).
+    fn chart_around(&self, start: u32, targets: &[u32]) -> Vec<u32> {
+        let mut reached = vec![start];
+        let mut frontier = 0;
+        for _ in 0..CHART_STEPS {
+            if targets.iter().all(|t| reached.contains(t)) {
+                break;
+            }
+            let end = reached.len();
+            for k in frontier..end {
+                for &g in &self.smooth_neighbors[reached[k] as usize] {
+                    if !reached.contains(&g) {
+                        reached.push(g);
+                    }
+                }
+            }
+            frontier = end;
+        }
+        reached
+    }
+
+    /// The three landings of a triangle of B read in one chart: the leading corner's walk
+    /// (module docs) keeps the corners it reaches and re-locates the others onto it.
+    fn in_one_chart(&self, landings: [Option<Landing>; 3]) -> [Option<Landing>; 3] {
+        let targets: Vec<u32> = landings.iter().flatten().map(|l| l.face).collect();
+        let mut best: Option<(usize, Vec<u32>)> = None;
+        for &lead in &targets {
+            let chart = self.chart_around(lead, &targets);
+            let reached = targets.iter().filter(|t| chart.contains(t)).count();
+            if best.as_ref().is_none_or(|(n, _)| reached > *n) {
+                best = Some((reached, chart));
+            }
+        }
+        let Some((_, chart)) = best else {
+            return landings;
+        };
+        landings.map(|landing| {
+            landing.map(|l| {
+                if chart.contains(&l.face) {
+                    l
+                } else {
+                    self.relocated(l, &chart)
+                }
+            })
+        })
+    }
+
+    /// The point of A a landing stands for.
+    fn point(&self, landing: &Landing) -> [f64; 3] {
         let vertices = self.a.vertices();
         let t = self.faces[landing.face as usize];
-        let point = [0, 1, 2].map(|c| {
+        [0, 1, 2].map(|c| {
             (0..3)
                 .map(|i| landing.weights[i] * vertices[t[i] as usize][c])
                 .sum::<f64>()
-        });
-        let representative = self.a.representative();
+        })
+    }
+
+    /// `landing` moved to the closest point of the triangles `chart` (in space).
+    fn relocated(&self, landing: Landing, chart: &[u32]) -> Landing {
+        let vertices = self.a.vertices();
+        let point = self.point(&landing);
         let mut best: Option<(f64, u32, [f64; 3])> = None;
-        for &v in &t {
-            for &f in &self.around[representative[v as usize] as usize] {
-                if self.island[f as usize] != island {
-                    continue;
-                }
-                let corners = self.faces[f as usize].map(|u| vertices[u as usize]);
-                let (d2, weights) = closest_on_triangle(&point, &corners);
-                if best.is_none_or(|(d, g, _)| d2 < d || (d2 == d && f < g)) {
-                    best = Some((d2, f, weights));
-                }
+        for &f in chart {
+            let corners = self.faces[f as usize].map(|u| vertices[u as usize]);
+            let (d2, weights) = closest_on_triangle(&point, &corners);
+            if best.is_none_or(|(d, g, _)| d2 < d || (d2 == d && f < g)) {
+                best = Some((d2, f, weights));
             }
         }
         best.map_or(landing, |(_, face, weights)| Landing { face, weights })
@@ -197,20 +242,6 @@ impl<'a> Islands<'a> {
         }
         vec![0.0; self.channels]
     }
-}
-
-/// The island most of the three corners landed in (the first corner's on a tie); None when
-/// none landed.
-fn majority(islands: [Option<usize>; 3]) -> Option<usize> {
-    let landed: Vec<usize> = islands.iter().flatten().copied().collect();
-    let count = |i: usize| landed.iter().filter(|&&j| j == i).count();
-    let mut best = *landed.first()?;
-    for &i in &landed {
-        if count(i) > count(best) {
-            best = i;
-        }
-    }
-    Some(best)
 }
 
 fn check(
