@@ -31,8 +31,9 @@ to B through the correspondence, whatever their poses and bodies::
     python meshlab_plugin/shapecorr_meshlab.py transfer A.ply B.ply --out B_from_A.ply
     out, pointwise = shapecorr_meshlab.transfer(ms)    # a MeshSet with B carrying A's data
 
-(A file named ``transfer`` as the first mesh is spelt ``./transfer``.) Per-wedge texture
-coordinates are not carried yet.
+Per-wedge texture coordinates (a UV layout with seams, as OBJ files carry it) are carried
+per corner, seams kept: a UV island of A stays one island on B (``SurfaceMap.transfer_corners``).
+(A file named ``transfer`` as the first mesh is spelt ``./transfer``.)
 """
 
 import argparse
@@ -116,8 +117,9 @@ def match_with_shapes(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False,
 
 def transfer(ms, id_a=0, id_b=1, colors=True, quality=True, texcoords=True, progress=None, **options):
     """Carries per-vertex data of mesh ``id_a`` of the MeshSet ``ms`` to mesh ``id_b``
-    through the correspondence (any pose and body): vertex colours and texture coordinates
-    interpolated on A's surface, the vertex quality too. Returns ``(meshset, pointwise)``: a
+    through the correspondence (any pose and body): vertex colours, quality and texture
+    coordinates interpolated on A's surface; per-wedge texture coordinates carried per
+    corner with A's seams kept. Returns ``(meshset, pointwise)``: a
     new MeshSet holding a copy of B with what A has of these (``colors``, ``quality``,
     ``texcoords`` say which), and the shapecorr.PointwiseMap (its ``confidence`` and
     ``warning``: see :func:`report`). ``options`` as :func:`match_regions`'. Raises
@@ -132,12 +134,17 @@ def transfer(ms, id_a=0, id_b=1, colors=True, quality=True, texcoords=True, prog
         carried["v_scalar_array"] = mesh_a.vertex_scalar_array()
     if texcoords and mesh_a.has_vertex_tex_coord():
         carried["v_tex_coords_matrix"] = mesh_a.vertex_tex_coord_matrix()
-    if not carried:
+    wedges = texcoords and mesh_a.has_wedge_tex_coord()
+    if not carried and not wedges:
         raise ValueError("mesh A has none of what was asked (vertex colours, quality, texture coordinates)")
     shapes = (shape_of(mesh_a), shape_of(mesh_b))
     pointwise = shapecorr.pointwise_map(*shapes, progress=progress, **options)
     onto = shapecorr.surface_map(*shapes, pointwise, progress=progress)
     values = {name: onto.transfer(array) for name, array in carried.items()}
+    if wedges:
+        corners = mesh_a.wedge_tex_coord_matrix().reshape(-1, 3, 2)
+        carried_corners = onto.transfer_corners(shapes[0], mesh_a.face_matrix(), corners, mesh_b.face_matrix())
+        values["w_tex_coords_matrix"] = carried_corners.reshape(-1, 2)
     if "v_color_matrix" in values:
         values["v_color_matrix"] = np.clip(values["v_color_matrix"], 0.0, 1.0)
     out = pymeshlab.MeshSet()
@@ -247,14 +254,31 @@ def transfer_parser():
     return parser
 
 
-def main_transfer(argv):
-    args = transfer_parser().parse_args(argv)
+def load_pair(a, b):
+    """A MeshSet holding the files ``a`` and ``b`` (mesh 0 and 1), or None with the reason
+    printed on stderr."""
     ms = pymeshlab.MeshSet()
     try:
-        ms.load_new_mesh(str(args.a))
-        ms.load_new_mesh(str(args.b))
+        ms.load_new_mesh(str(a))
+        ms.load_new_mesh(str(b))
     except pymeshlab.PyMeshLabException as error:
         print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
+        return None
+    return ms
+
+
+def print_report(wrote, lines):
+    """The report's first line after what was written (stdout), the warnings on stderr."""
+    summary, *warnings = lines
+    print(f"shapecorr_meshlab: wrote {wrote} ({summary})")
+    for line in warnings:
+        print(f"shapecorr_meshlab: {line}", file=sys.stderr)
+
+
+def main_transfer(argv):
+    args = transfer_parser().parse_args(argv)
+    ms = load_pair(args.a, args.b)
+    if ms is None:
         return 1
     try:
         out, pointwise = transfer(
@@ -267,12 +291,9 @@ def main_transfer(argv):
     mesh = out.current_mesh()
     out.save_current_mesh(
         str(args.out), save_vertex_color=mesh.has_vertex_color(), save_vertex_quality=mesh.has_vertex_scalar(),
-        save_vertex_coord=mesh.has_vertex_tex_coord(),
+        save_vertex_coord=mesh.has_vertex_tex_coord(), save_wedge_texcoord=mesh.has_wedge_tex_coord(),
     )
-    summary, *warnings = report(pointwise)
-    print(f"shapecorr_meshlab: wrote {args.out} ({summary})")
-    for line in warnings:
-        print(f"shapecorr_meshlab: {line}", file=sys.stderr)
+    print_report(args.out, report(pointwise))
     return 0
 
 
@@ -283,12 +304,8 @@ def main(argv=None):
     args = argument_parser().parse_args(argv)
     options = options_of(args)
     one_to_one = options.pop("one_to_one", True) and not args.symmetric
-    ms = pymeshlab.MeshSet()
-    try:
-        ms.load_new_mesh(str(args.a))
-        ms.load_new_mesh(str(args.b))
-    except pymeshlab.PyMeshLabException as error:
-        print(f"shapecorr_meshlab: cannot load: {error}", file=sys.stderr)
+    ms = load_pair(args.a, args.b)
+    if ms is None:
         return 1
     try:
         out, result, shapes = match_with_shapes(
@@ -300,10 +317,7 @@ def main(argv=None):
     for mesh_id, path in ((0, args.out_a), (1, args.out_b)):
         out.set_current_mesh(mesh_id)
         out.save_current_mesh(str(path), save_vertex_color=True, save_vertex_quality=True)
-    summary, *warnings = report(result, shapes)
-    print(f"shapecorr_meshlab: wrote {args.out_a} and {args.out_b} ({summary})")
-    for line in warnings:
-        print(f"shapecorr_meshlab: {line}", file=sys.stderr)
+    print_report(f"{args.out_a} and {args.out_b}", report(result, shapes))
     return 0
 
 

@@ -333,30 +333,21 @@ def test_render_the_coloured_figures_with_cycles(addon, tmp_path):
 # ------------------------------------------------------------------------ Transfer (issue 21)
 
 
+def library_shape(addon, obj):
+    """The library's shape of ``obj`` as the add-on reads it (world space, loop triangles)."""
+    n = len(obj.data.vertices)
+    co = np.empty(3 * n, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    world = co.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+    return addon.shapecorr.Shape.mesh(world, loop_triangles(obj)[0])
+
+
 def library_surface_map(addon, a, b):
     """The library's surface map on the world-space data the add-on reads from ``a``, ``b``."""
-    sc = addon.shapecorr
-    shapes = []
-    for obj in (a, b):
-        n = len(obj.data.vertices)
-        co = np.empty(3 * n, dtype=np.float32)
-        obj.data.vertices.foreach_get("co", co)
-        matrix = np.array(obj.matrix_world, dtype=np.float64)
-        world = co.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
-        triangles = np.array([tuple(p.vertices) for p in obj.data.polygons], dtype=np.uint32)
-        shapes.append(sc.Shape.mesh(world, triangles))
-    pointwise = sc.pointwise_map(*shapes)
-    return sc.surface_map(shapes[0], shapes[1], pointwise), pointwise
-
-
-def library_shape_a(addon, a):
-    """The library's shape of ``a`` as the add-on reads it (world space, loop triangles)."""
-    n = len(a.data.vertices)
-    co = np.empty(3 * n, dtype=np.float32)
-    a.data.vertices.foreach_get("co", co)
-    matrix = np.array(a.matrix_world, dtype=np.float64)
-    world = co.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
-    return addon.shapecorr.Shape.mesh(world, loop_triangles(a)[0])
+    shapes = [library_shape(addon, obj) for obj in (a, b)]
+    pointwise = addon.shapecorr.pointwise_map(*shapes)
+    return addon.shapecorr.surface_map(shapes[0], shapes[1], pointwise), pointwise
 
 
 def group_weights(obj, name):
@@ -466,7 +457,7 @@ def test_transfer_carries_groups_colours_and_attributes_like_the_library(addon):
     # The UV map per corner, as the library carries it (tests/transfer.rs checks the seams).
     faces_a, loops_a = loop_triangles(a)
     faces_b, loops_b = loop_triangles(b)
-    expected = onto.transfer_corners(library_shape_a(addon, a), faces_a, loop_uv(a, "cylinder")[loops_a], faces_b)
+    expected = onto.transfer_corners(library_shape(addon, a), faces_a, loop_uv(a, "cylinder")[loops_a], faces_b)
     got = loop_uv(b, "cylinder")[loops_b]
     assert np.allclose(got, expected, atol=1e-6)
 

@@ -216,6 +216,43 @@ def test_transfer_function_carries_colours_quality_and_texcoords_like_the_librar
     assert pointwise.confidence is not None
 
 
+def cylinder_wedges(vertices, triangles):
+    """A per-wedge UV layout: u the angle about the vertical axis, v the height; a triangle
+    across the back takes u + 1 at its corners below 0.5 (the back is a seam)."""
+    u = np.arctan2(vertices[:, 0], vertices[:, 2]) / (2 * np.pi) + 0.5
+    v = (vertices[:, 1] - vertices[:, 1].min()) / np.ptp(vertices[:, 1])
+    corners = np.stack([u[triangles], v[triangles]], axis=2)
+    across = (corners[:, :, 0].max(axis=1) > 0.75) & (corners[:, :, 0].min(axis=1) < 0.25)
+    corners[:, :, 0] += np.where(across[:, None] & (corners[:, :, 0] < 0.5), 1.0, 0.0)
+    return corners
+
+
+def test_transfer_carries_wedge_texcoords_per_corner_with_the_seam_kept():
+    a = shapecorr.Shape.figure("humanoid", 0, 2500)
+    b = shapecorr.Shape.figure("humanoid", 3, 2500)
+    corners_a = cylinder_wedges(a.vertices, a.triangles)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=a.vertices, face_matrix=a.triangles.astype(np.int32),
+                               w_tex_coords_matrix=corners_a.reshape(-1, 2)))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=b.vertices, face_matrix=b.triangles.astype(np.int32)))
+    out, _ = shapecorr_meshlab.transfer(ms)
+    carried = out.mesh(0).wedge_tex_coord_matrix().reshape(-1, 3, 2)
+    shape_a, shape_b = shapecorr_meshlab.shape_of(ms.mesh(0)), shapecorr_meshlab.shape_of(ms.mesh(1))
+    onto = shapecorr.surface_map(shape_a, shape_b, shapecorr.pointwise_map(shape_a, shape_b))
+    assert np.allclose(carried, onto.transfer_corners(shape_a, a.triangles, corners_a, b.triangles), atol=1e-6)
+    # B's own layout (the figures share their triangles): close where the truth does not
+    # cross the seam, and no more triangles smeared across the seam (a u-span far above a
+    # triangle's own) than the truth has near the poles of the angle.
+    truth = cylinder_wedges(b.vertices, b.triangles)
+    inside = np.ptp(truth[:, :, 0], axis=1) < 0.1
+    assert np.median(np.abs(carried[inside] - truth[inside])) < 0.03
+    smeared = np.count_nonzero(np.ptp(carried[:, :, 0], axis=1) > 0.3)
+    assert smeared <= np.count_nonzero(np.ptp(truth[:, :, 0], axis=1) > 0.3) + 0.005 * len(carried)
+    # Per vertex (what MeshLab had before wedges were carried) the seam is smeared.
+    per_vertex = onto.transfer(np.arctan2(a.vertices[:, 0], a.vertices[:, 2]) / (2 * np.pi) + 0.5)
+    assert np.count_nonzero(np.ptp(per_vertex[b.triangles], axis=1) > 0.3) > smeared + 10
+
+
 def test_transfer_command_writes_b_with_a_colours(tmp_path):
     ms, _, _, _, _ = painted_pair()
     for mesh_id, name in ((0, "a.ply"), (1, "b.ply")):

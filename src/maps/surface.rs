@@ -112,7 +112,7 @@ fn surface_points(
     cancel: &Cancel,
 ) -> Result<Vec<SurfacePoint>> {
     let neighbors = neighbors_of(b);
-    let incident = incident_triangles(a);
+    let incident = (a.kind() == ShapeKind::Mesh).then(|| a.triangles_around_vertices());
     let tear2 = (TEAR_EDGES * mean_edge_length(a)).powi(2);
     let pa = a.vertices();
     let representative = b.representative();
@@ -218,19 +218,6 @@ fn neighbors_of(b: &Shape) -> Vec<Vec<u32>> {
 }
 
 /// The triangles around every vertex of A (None for a point cloud).
-fn incident_triangles(a: &Shape) -> Option<Vec<Vec<u32>>> {
-    if a.kind() == ShapeKind::PointCloud {
-        return None;
-    }
-    let mut incident = vec![Vec::new(); a.n_vertices()];
-    for (f, t) in a.triangles().iter().enumerate() {
-        for &v in t {
-            incident[v as usize].push(f as u32);
-        }
-    }
-    Some(incident)
-}
-
 fn squared_distance(p: &[f64; 3], q: &[f64; 3]) -> f64 {
     (0..3).map(|c| (p[c] - q[c]).powi(2)).sum()
 }

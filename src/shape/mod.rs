@@ -527,6 +527,18 @@ impl Shape {
         &self.triangles
     }
 
+    /// For every vertex, the indices of the triangles that use it (empty lists for a point
+    /// cloud). Built on demand: O(n) time and memory.
+    pub fn triangles_around_vertices(&self) -> Vec<Vec<u32>> {
+        let mut around = vec![Vec::new(); self.vertices.len()];
+        for (f, t) in self.triangles.iter().enumerate() {
+            for &v in t {
+                around[v as usize].push(f as u32);
+            }
+        }
+        around
+    }
+
     /// Mesh or point cloud.
     pub fn kind(&self) -> ShapeKind {
         self.kind

@@ -138,12 +138,7 @@ fn locate(shape: &Shape, proxy: &Shape) -> Vec<SurfacePoint> {
         .map(|&v| proxy.vertices()[v as usize])
         .collect();
     let tree = PointTree::new(&active_points);
-    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); proxy.n_vertices()];
-    for (f, t) in proxy.triangles().iter().enumerate() {
-        for &v in t {
-            incident[v as usize].push(f as u32);
-        }
-    }
+    let incident = proxy.triangles_around_vertices();
     let at = |query: &[f64; 3]| -> SurfacePoint {
         let near = tree.nearest_k(query, NEAREST_PROXY_VERTICES.max(3));
         if proxy.kind() == ShapeKind::PointCloud {

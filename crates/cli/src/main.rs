@@ -20,6 +20,7 @@ use commands::info::InfoArgs;
 use commands::p2p::P2pArgs;
 use commands::regions::{MatchArgs, SymmetryArgs};
 use commands::synth::SynthArgs;
+use commands::transfer::TransferArgs;
 
 #[derive(Parser)]
 #[command(
@@ -63,6 +64,11 @@ enum Command {
     /// by its normalised coordinates) and DIR/b_mapped.ply (B with A's colours carried over
     /// by the map). The confidence and warning as `match`'s, for the map's answer.
     P2p(P2pArgs),
+    /// Values on A's vertices (a text file, a row per vertex) carried to B's vertices
+    /// through the point-to-point map, interpolated on A's surface (`--mode interpolate`),
+    /// by nearest vertex (`nearest`: labels) or as skin weights (`weights`). The map's
+    /// confidence and warning as `p2p`'s. See docs/transfer.md.
+    Transfer(TransferArgs),
     /// Benchmarks on the research datasets.
     Bench {
         #[command(subcommand)]
@@ -106,6 +112,7 @@ fn run(cli: &Cli) -> ExitCode {
         Command::Match(args) => args.run(),
         Command::Symmetry(args) => args.run(),
         Command::P2p(args) => args.run(),
+        Command::Transfer(args) => args.run(),
         Command::Bench { which } => which.run(),
         Command::Demo(args) => args.run(),
     };

@@ -752,3 +752,110 @@ fn repairs_are_printed_and_can_be_switched_off() {
     assert!(!stderr.contains("repaired"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `shapecorr transfer`: A's values carried to B (generated figures share their vertex
+/// order, so B's vertex i should get A's value at vertex i); the written surface map gives
+/// the same values; bad value files are refused naming the file and the line.
+#[test]
+fn transfer_carries_values_like_the_written_surface_map_and_refuses_bad_files() {
+    let dir = scratch("transfer");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth_figure("humanoid", "0", "3000", &a);
+    synth_figure("humanoid", "3", "3000", &b);
+    let shape_a = shapecorr::Shape::read(&a, shapecorr::ReadAs::Auto).unwrap();
+    let ys: Vec<f64> = shape_a.vertices().iter().map(|p| p[1]).collect();
+    let (low, high) = ys
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), &y| (l.min(y), h.max(y)));
+    // Two columns: the rest height in [0, 1] and a label, left or right (0 or 1).
+    let values: Vec<[f64; 2]> = shape_a
+        .vertices()
+        .iter()
+        .map(|p| [(p[1] - low) / (high - low), f64::from(u8::from(p[0] > 0.0))])
+        .collect();
+    let text: String = values.iter().map(|[h, s]| format!("{h}, {s}\n")).collect();
+    let values_path = dir.join("values_a.txt");
+    std::fs::write(&values_path, format!("# height, side\n{text}")).unwrap();
+    let read_rows = |path: &Path| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .map(|l| l.split(' ').map(|w| w.parse().unwrap()).collect())
+            .collect()
+    };
+    for mode in ["interpolate", "nearest"] {
+        let (out, onto) = (dir.join(format!("b_{mode}.txt")), dir.join("onto.txt"));
+        let run = shapecorr(&[
+            "transfer",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--values",
+            values_path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--mode",
+            mode,
+            "--surface-map",
+            onto.to_str().unwrap(),
+        ]);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert!(String::from_utf8_lossy(&run.stdout).contains("confidence"));
+        let carried = read_rows(&out);
+        let points = read_rows(&onto);
+        assert_eq!(carried.len(), values.len());
+        let mut height_error = Vec::new();
+        let mut side_right = 0;
+        for (v, (row, point)) in carried.iter().zip(&points).enumerate() {
+            assert_eq!(row.len(), 2);
+            let weights = &point[3..];
+            assert!((weights.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+            let corner = |k: usize| values[point[k] as usize];
+            let expected: Vec<f64> = if mode == "nearest" {
+                corner(0).to_vec() // heaviest first
+            } else {
+                (0..2)
+                    .map(|c| (0..3).map(|k| weights[k] * corner(k)[c]).sum())
+                    .collect()
+            };
+            assert!((row[0] - expected[0]).abs() < 1e-9 && (row[1] - expected[1]).abs() < 1e-9);
+            height_error.push((row[0] - values[v][0]).abs());
+            side_right += usize::from((row[1] - values[v][1]).abs() < 0.5);
+        }
+        height_error.sort_by(f64::total_cmp);
+        let median = height_error[height_error.len() / 2];
+        assert!(median < 0.02, "{mode}: median height error {median}");
+        assert!(
+            side_right > 9 * values.len() / 10,
+            "{mode}: {side_right} sides right"
+        );
+    }
+    // Bad files: a row short, a word that is not a number, a row count that is not A's.
+    let bad = [
+        ("0.5, 1\n0.5\n", "line 2 has 1 values"),
+        ("0.5, one\n", "line 1: `one` is not a number"),
+        ("0.5, 1\n", "1 rows of values, but shape A has"),
+    ];
+    for (content, message) in bad {
+        std::fs::write(&values_path, content).unwrap();
+        let run = shapecorr(&[
+            "transfer",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--values",
+            values_path.to_str().unwrap(),
+            "--out",
+            dir.join("never.txt").to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success());
+        assert!(
+            stderr.contains(message) && stderr.contains("values_a.txt"),
+            "{stderr}"
+        );
+    }
+    assert!(!dir.join("never.txt").exists());
+}

@@ -7,6 +7,7 @@ pub mod info;
 pub mod p2p;
 pub mod regions;
 pub mod synth;
+pub mod transfer;
 
 use std::path::Path;
 
