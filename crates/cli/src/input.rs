@@ -1,7 +1,7 @@
 //! Reading the input shapes: the repairs (on unless `--no-repair`), errors naming the side
 //! and the file, and the repairs made printed on stderr, one line each, naming the input.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use shapecorr::{Error, ReadAs, Repairs, Shape};
 
@@ -33,4 +33,35 @@ pub fn read_input(side: char, path: &Path, points: bool, no_repair: bool) -> Res
         eprintln!("shapecorr: repaired {side} ({}): {warning}", path.display());
     }
     Ok(shape)
+}
+
+/// The two shape files of a pair command (`match`, `p2p`, `transfer`) and how they are read.
+#[derive(clap::Args)]
+pub struct ShapePairArgs {
+    /// Shape A (PLY, OFF or OBJ).
+    pub a: PathBuf,
+    /// Shape B.
+    pub b: PathBuf,
+    /// Treat both files as point clouds even if they have faces.
+    #[arg(long)]
+    pub points: bool,
+    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
+    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
+    #[arg(long)]
+    pub no_repair: bool,
+}
+
+impl ShapePairArgs {
+    /// Shapes A and B, read as [`read_input`].
+    pub fn read(&self) -> Result<(Shape, Shape), Error> {
+        Ok((
+            read_input('A', &self.a, self.points, self.no_repair)?,
+            read_input('B', &self.b, self.points, self.no_repair)?,
+        ))
+    }
+
+    /// An error about shape A or B as one naming its file ([`naming_files`]).
+    pub fn naming(&self, e: Error) -> Error {
+        naming_files(e, &self.a, &self.b)
+    }
 }

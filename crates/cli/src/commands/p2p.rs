@@ -6,8 +6,7 @@ use serde_json::json;
 use shapecorr::maps::pointwise::PointwiseCorrespondence;
 use shapecorr::Error;
 
-use crate::commands::naming_files;
-use crate::input::read_input;
+use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
 use crate::output::{
     budget_json, confidence_summary, correspondence_json, create_dir, end_progress_line,
@@ -17,17 +16,11 @@ use crate::output::{
 
 #[derive(clap::Args)]
 pub struct P2pArgs {
-    a: PathBuf,
-    b: PathBuf,
+    #[command(flatten)]
+    pair: ShapePairArgs,
     /// Output folder (created if missing).
     #[arg(long)]
     out: PathBuf,
-    #[arg(long)]
-    points: bool,
-    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
-    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
-    #[arg(long)]
-    no_repair: bool,
     #[command(flatten)]
     options: PointwiseOptions,
 }
@@ -35,8 +28,7 @@ pub struct P2pArgs {
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let shape_a = read_input('A', &self.a, self.points, self.no_repair)?;
-        let shape_b = read_input('B', &self.b, self.points, self.no_repair)?;
+        let (shape_a, shape_b) = self.pair.read()?;
         let out = &self.out;
         create_dir(out)?;
         let result = PointwiseCorrespondence::compute(
@@ -47,7 +39,7 @@ impl P2pArgs {
             &mut TerminalProgress::new(),
         );
         end_progress_line();
-        let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
+        let result = result.map_err(|e| self.pair.naming(e))?;
         let map = &result.map.p2p_ba;
         write_map(&out.join("map_b_to_a.txt"), map)?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result.regions);

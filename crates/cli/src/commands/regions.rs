@@ -7,8 +7,7 @@ use serde_json::json;
 use shapecorr::correspondence::{Correspondence, Symmetry};
 use shapecorr::Error;
 
-use crate::commands::naming_files;
-use crate::input::read_input;
+use crate::input::{read_input, ShapePairArgs};
 use crate::options::RegionOptions;
 use crate::output::{
     budget_json, confidence_summary, correspondence_json, create_dir, end_progress_line,
@@ -17,18 +16,11 @@ use crate::output::{
 
 #[derive(clap::Args)]
 pub struct MatchArgs {
-    a: PathBuf,
-    b: PathBuf,
+    #[command(flatten)]
+    pair: ShapePairArgs,
     /// Output folder (created if missing).
     #[arg(long)]
     out: PathBuf,
-    /// Treat both files as point clouds even if they have faces.
-    #[arg(long)]
-    points: bool,
-    /// Use the shapes as given: no welding of coincident vertices, no leaving out of small
-    /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
-    #[arg(long)]
-    no_repair: bool,
     #[command(flatten)]
     options: RegionOptions,
 }
@@ -36,8 +28,7 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape_a = read_input('A', &self.a, self.points, self.no_repair)?;
-        let shape_b = read_input('B', &self.b, self.points, self.no_repair)?;
+        let (shape_a, shape_b) = self.pair.read()?;
         let out = &self.out;
         create_dir(out)?;
         let result = Correspondence::compute(
@@ -47,7 +38,7 @@ impl MatchArgs {
             &mut TerminalProgress::new(),
         );
         end_progress_line();
-        let result = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
+        let result = result.map_err(|e| self.pair.naming(e))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
         value["options"] = options_json(&options, false);
         value["budget"] = budget_json(&Correspondence::job(&shape_a, &shape_b, &options.params));

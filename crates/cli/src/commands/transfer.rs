@@ -9,8 +9,7 @@ use shapecorr::maps::surface::SurfaceMap;
 use shapecorr::transfer::TransferMode;
 use shapecorr::Error;
 
-use crate::commands::naming_files;
-use crate::input::read_input;
+use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
 use crate::output::{confidence_summary, end_progress_line, print_warning, TerminalProgress};
 
@@ -27,8 +26,8 @@ enum Mode {
 
 #[derive(clap::Args)]
 pub struct TransferArgs {
-    a: PathBuf,
-    b: PathBuf,
+    #[command(flatten)]
+    pair: ShapePairArgs,
     /// Values on A: a text file with one row per vertex of A, in A's vertex order, numbers
     /// separated by spaces, tabs or commas (every row the same count); `#` starts a comment.
     #[arg(long)]
@@ -45,11 +44,6 @@ pub struct TransferArgs {
     /// vertices of A and their three weights (`a0 a1 a2 w0 w1 w2`).
     #[arg(long)]
     surface_map: Option<PathBuf>,
-    #[arg(long)]
-    points: bool,
-    /// Use the shapes as given (as `p2p --no-repair`).
-    #[arg(long)]
-    no_repair: bool,
     #[command(flatten)]
     options: PointwiseOptions,
 }
@@ -57,8 +51,7 @@ pub struct TransferArgs {
 impl TransferArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let shape_a = read_input('A', &self.a, self.points, self.no_repair)?;
-        let shape_b = read_input('B', &self.b, self.points, self.no_repair)?;
+        let (shape_a, shape_b) = self.pair.read()?;
         let (values, channels) = read_values(&self.values, shape_a.n_vertices())?;
         let mut progress = TerminalProgress::new();
         let result = PointwiseCorrespondence::compute(
@@ -78,7 +71,7 @@ impl TransferArgs {
             Ok((result, onto))
         });
         end_progress_line();
-        let (result, onto) = result.map_err(|e| naming_files(e, &self.a, &self.b))?;
+        let (result, onto) = result.map_err(|e| self.pair.naming(e))?;
         let mode = match self.mode {
             Mode::Interpolate => TransferMode::Interpolate,
             Mode::Nearest => TransferMode::Nearest,
