@@ -37,6 +37,7 @@ per corner, seams kept: a UV island of A stays one island on B (``SurfaceMap.tra
 """
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
@@ -267,6 +268,23 @@ def load_pair(a, b):
     return ms
 
 
+def save_current(ms, path, **wanted):
+    """Saves the current mesh of ``ms`` to ``path`` with the ``save_*`` flags its format
+    has (an OBJ or OFF file has no vertex quality: pymeshlab refuses the flag, so it is
+    left out). False, with the reason on stderr, when the file cannot be written."""
+    wanted = dict(wanted)
+    while True:
+        try:
+            ms.save_current_mesh(str(path), **wanted)
+            return True
+        except pymeshlab.PyMeshLabException as error:
+            unknown = re.search(r"Parameter (\w+) not found", str(error))
+            if unknown is None or unknown.group(1) not in wanted:
+                print(f"shapecorr_meshlab: cannot save {path}: {error}", file=sys.stderr)
+                return False
+            del wanted[unknown.group(1)]
+
+
 def print_report(wrote, lines):
     """The report's first line after what was written (stdout), the warnings on stderr."""
     summary, *warnings = lines
@@ -289,10 +307,11 @@ def main_transfer(argv):
         print(f"shapecorr_meshlab: {error}", file=sys.stderr)
         return 1
     mesh = out.current_mesh()
-    out.save_current_mesh(
-        str(args.out), save_vertex_color=mesh.has_vertex_color(), save_vertex_quality=mesh.has_vertex_scalar(),
+    if not save_current(
+        out, args.out, save_vertex_color=mesh.has_vertex_color(), save_vertex_quality=mesh.has_vertex_scalar(),
         save_vertex_coord=mesh.has_vertex_tex_coord(), save_wedge_texcoord=mesh.has_wedge_tex_coord(),
-    )
+    ):
+        return 1
     print_report(args.out, report(pointwise))
     return 0
 
@@ -316,7 +335,8 @@ def main(argv=None):
         return 1
     for mesh_id, path in ((0, args.out_a), (1, args.out_b)):
         out.set_current_mesh(mesh_id)
-        out.save_current_mesh(str(path), save_vertex_color=True, save_vertex_quality=True)
+        if not save_current(out, path, save_vertex_color=True, save_vertex_quality=True):
+            return 1
     print_report(f"{args.out_a} and {args.out_b}", report(result, shapes))
     return 0
 

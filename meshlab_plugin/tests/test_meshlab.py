@@ -265,6 +265,14 @@ def test_transfer_command_writes_b_with_a_colours(tmp_path):
     loaded = pymeshlab.MeshSet()
     loaded.load_new_mesh(str(out))
     assert loaded.current_mesh().has_vertex_color()
+    # Formats without vertex quality (OBJ, OFF) are written without it, not refused; a
+    # folder that does not exist is a reason and exit 1, not a traceback.
+    for suffix in ("obj", "off"):
+        written = tmp_path / f"b_from_a.{suffix}"
+        done = run_script("transfer", tmp_path / "a.ply", tmp_path / "b.ply", "--out", written)
+        assert done.returncode == 0 and written.exists(), done.stderr
+    done = run_script("transfer", tmp_path / "a.ply", tmp_path / "b.ply", "--out", tmp_path / "no" / "b.ply")
+    assert done.returncode == 1 and "cannot save" in done.stderr and "Traceback" not in done.stderr, done.stderr
     # Nothing to carry, or no faces: a reason and exit 1.
     plain = pymeshlab.MeshSet()
     plain.add_mesh(pymeshlab.Mesh(vertex_matrix=ms.mesh(1).vertex_matrix(), face_matrix=ms.mesh(1).face_matrix()))
