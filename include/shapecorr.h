@@ -59,6 +59,16 @@
 // Carrying data from A to B (`sc_surface_map_new`).
 #define SC_STAGE_TRANSFER 9
 
+// `sc_batch_new` flag: point-to-point maps too (as `sc_pointwise_map`), each written to
+// `OUT_DIR/maps/A--B.u32` (a vertex of A for every vertex of B, little-endian u32).
+#define SC_BATCH_MAPS 1
+
+// `sc_batch_new` flag: read every file as a point cloud.
+#define SC_BATCH_POINTS 2
+
+// `sc_batch_new` flag: read the files as given, without the default repairs.
+#define SC_BATCH_NO_REPAIR 4
+
 // Side A: the first shape given to `sc_match`.
 #define SC_SIDE_A 0
 
@@ -179,6 +189,14 @@ typedef uint32_t sc_status;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// The settings of a batch and the shapes it keeps prepared in memory. One per process is
+// enough: it may be used from several threads at once. Free it with `sc_batch_free`.
+typedef struct ScBatch ScBatch;
+
+// A batch log line: a shape's (`sc_batch_prepare`) or a pair's (`sc_batch_match`). Free
+// it with `sc_batch_record_free`.
+typedef struct ScBatchRecord ScBatchRecord;
+
 // The result of `sc_match`. Immutable: one handle may be read from several threads at
 // once. Free it with `sc_correspondence_free`.
 typedef struct sc_correspondence sc_correspondence;
@@ -231,6 +249,75 @@ uint32_t sc_version_patch(void);
 
 // ABI version of the loaded library (compare with `SC_ABI_VERSION`).
 uint32_t sc_abi_version(void);
+
+// A batch with these options (`params` may be NULL: the defaults), eigenbases cached in
+// `cache_dir` (created if missing; shared by every process of the batch), and `flags`
+// (`SC_BATCH_*`).
+//
+// Errors: `SC_STATUS_INVALID_PARAMETER`, `SC_STATUS_FILE_ERROR` (the cache folder cannot be
+// made), `SC_STATUS_INVALID_ARGUMENT` (an unknown flag).
+//
+// # Safety
+// `params` NULL or live; `cache_dir` a NUL-terminated path; `out_batch` writable.
+sc_status sc_batch_new(const sc_params *params,
+                       const char *cache_dir,
+                       uint32_t flags,
+                       ScBatch **out_batch);
+
+// Frees a batch (NULL is a no-op).
+//
+// # Safety
+// `batch` NULL or live, and not used again.
+void sc_batch_free(ScBatch *batch);
+
+// The per-shape job: the shape in `path`, named `name` in the batch, read, its proxy built
+// when dense and its eigenbasis loaded from the cache or computed and stored. The record
+// is the line of `shapes.jsonl`: `ok`, `error` (the library's message), `computed`
+// (false: from the cache), seconds. A shape that cannot be used is a record with `ok`
+// false, not an error status.
+//
+// # Safety
+// `batch` live; `name`, `path` NUL-terminated (UTF-8 name); `out_record` writable.
+sc_status sc_batch_prepare(const ScBatch *batch,
+                           const char *name,
+                           const char *path,
+                           ScBatchRecord **out_record);
+
+// The per-pair job: the regions (and with `SC_BATCH_MAPS` the map, written under
+// `out_dir/maps/`) of shapes A and B, each prepared as `sc_batch_prepare` (from memory or
+// the cache). The record is the line of `pairs.jsonl`: names, `ok`, `error`, `k`, the
+// regions of every vertex, the matches, `confidence`, `map` (the file, relative to
+// `out_dir`), seconds. A failed pair is a record with `ok` false and the reason, not an
+// error status.
+//
+// # Safety
+// `batch` live; the strings NUL-terminated (UTF-8 names); `out_record` writable.
+sc_status sc_batch_match(const ScBatch *batch,
+                         const char *name_a,
+                         const char *path_a,
+                         const char *name_b,
+                         const char *path_b,
+                         const char *out_dir,
+                         ScBatchRecord **out_record);
+
+// The record as one line of JSON (UTF-8, no newline). The string belongs to `record`:
+// valid until it is freed; never free it. NULL for NULL.
+//
+// # Safety
+// `record` NULL or live.
+const char *sc_batch_record_json(const ScBatchRecord *record);
+
+// Whether the record's job succeeded (false for NULL).
+//
+// # Safety
+// `record` NULL or live.
+bool sc_batch_record_ok(const ScBatchRecord *record);
+
+// Frees a record (NULL is a no-op).
+//
+// # Safety
+// `record` NULL or live, and not used again.
+void sc_batch_record_free(ScBatchRecord *record);
 
 // A short static description of a status code (`"unknown status"` for a number that is
 // not a status). Never free it.

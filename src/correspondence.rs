@@ -189,7 +189,7 @@ impl Correspondence {
             let mut result =
                 Correspondence::compute_within(working_a, working_b, params, progress)?;
             let t = Instant::now();
-            lift_regions(&mut result, &proxies);
+            lift_regions(&mut result, [proxy_a.as_ref(), proxy_b.as_ref()]);
             if proxy_a.is_some() || proxy_b.is_some() {
                 result.timings.proxies = built + t.elapsed().as_secs_f64();
             }

@@ -48,6 +48,7 @@
 #![warn(missing_docs)]
 
 pub mod budget;
+pub mod collection;
 pub mod colors;
 pub mod correspondence;
 pub mod error;

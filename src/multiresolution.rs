@@ -95,11 +95,7 @@ impl Multiresolution {
         polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
             let build = |shape: &Shape| -> Result<Option<Proxy>> {
                 cancel.check()?;
-                if self.applies_to(shape) {
-                    Proxy::build(shape, self.proxy_vertices).map(Some)
-                } else {
-                    Ok(None)
-                }
+                self.proxy(shape)
             };
             let proxy_a = build(a).map_err(|e| e.in_shape('A'))?;
             cancel.set_fraction(0.5);
@@ -109,13 +105,24 @@ impl Multiresolution {
     }
 }
 
+impl Multiresolution {
+    /// The proxy of `shape` when it needs one.
+    pub(crate) fn proxy(&self, shape: &Shape) -> Result<Option<Proxy>> {
+        if self.applies_to(shape) {
+            Proxy::build(shape, self.proxy_vertices).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+}
+
 /// The shape the pipeline runs on: the proxy's, or the shape itself.
 pub(crate) fn working<'a>(shape: &'a Shape, proxy: &'a Option<Proxy>) -> &'a Shape {
     proxy.as_ref().map_or(shape, |p| &p.shape)
 }
 
 /// The regions' labels of the working shapes brought back to every input vertex.
-pub(crate) fn lift_regions(regions: &mut Correspondence, [proxy_a, proxy_b]: &[Option<Proxy>; 2]) {
+pub(crate) fn lift_regions(regions: &mut Correspondence, [proxy_a, proxy_b]: [Option<&Proxy>; 2]) {
     for (graph, proxy) in [
         (&mut regions.graph_a, proxy_a),
         (&mut regions.graph_b, proxy_b),

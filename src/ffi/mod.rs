@@ -18,6 +18,7 @@
 //! of B; the pointwise map goes from B to A (a vertex of A for every vertex of B) and the
 //! functional map from A to B.
 
+mod batch;
 mod boundary;
 mod correspondence;
 mod params;
@@ -26,6 +27,7 @@ mod shape;
 mod symmetry;
 mod transfer;
 
+pub use batch::*;
 pub use boundary::{sc_last_error, sc_status_str, ScStatus};
 pub use correspondence::*;
 pub use params::*;

@@ -260,7 +260,7 @@ pub unsafe extern "C" fn sc_shape_read(
 }
 
 /// A path from C: any bytes on Unix (file names need not be UTF-8), UTF-8 elsewhere.
-unsafe fn input_path(ptr: *const c_char, name: &str) -> FfiResult<std::path::PathBuf> {
+pub(super) unsafe fn input_path(ptr: *const c_char, name: &str) -> FfiResult<std::path::PathBuf> {
     #[cfg(unix)]
     {
         use std::os::unix::ffi::OsStrExt;

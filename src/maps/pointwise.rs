@@ -759,7 +759,7 @@ impl PointwiseCorrespondence {
                 progress,
             )?;
             let t = Instant::now();
-            lift_regions(&mut result.regions, &proxies);
+            lift_regions(&mut result.regions, [proxy_a.as_ref(), proxy_b.as_ref()]);
             result.map.p2p_ba = lift_map((a, proxy_a), (b, proxy_b), &result.map.p2p_ba, progress)?;
             if proxy_a.is_some() || proxy_b.is_some() {
                 result.proxies = built + t.elapsed().as_secs_f64();
@@ -818,7 +818,7 @@ impl PointwiseCorrespondence {
 
 /// The eigensolver's parameters of a pointwise job: enough eigenpairs for the map and the
 /// regions, computed once per shape.
-fn basis_params(params: &Params, pointwise: &PointwiseParams) -> EigenParams {
+pub(crate) fn basis_params(params: &Params, pointwise: &PointwiseParams) -> EigenParams {
     EigenParams {
         n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
         ..params.eigen.clone()

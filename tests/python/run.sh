@@ -8,7 +8,7 @@ venv=target/py-venv
 if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
 fi
-"$venv/bin/python" -m pip install -q --disable-pip-version-check numpy pytest
+"$venv/bin/python" -m pip install -q --disable-pip-version-check numpy pytest "dask[distributed]" matplotlib
 "$venv/bin/python" -m pip install -q --disable-pip-version-check --force-reinstall --no-deps ./bindings/python
 # Run from the tests folder so `import shapecorr` finds the installed package, not the source.
 cd bindings/python/tests

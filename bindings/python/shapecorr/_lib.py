@@ -223,6 +223,14 @@ FUNCTIONS = {
         status,
         [handle, handle, c_u32p, c_size_t, c_f64p, c_size_t, c_u32p, c_size_t, c_size_t, c_f64p, c_size_t],
     ),
+    # collections
+    "sc_batch_new": (status, [handle, c_str, u32_arg, handle_out]),
+    "sc_batch_free": (None, [handle]),
+    "sc_batch_prepare": (status, [handle, c_str, c_str, handle_out]),
+    "sc_batch_match": (status, [handle, c_str, c_str, c_str, c_str, c_str, handle_out]),
+    "sc_batch_record_json": (ctypes.c_char_p, [handle]),
+    "sc_batch_record_ok": (ctypes.c_bool, [handle]),
+    "sc_batch_record_free": (None, [handle]),
 }
 
 def _raising_the_original(function):
@@ -291,5 +299,7 @@ STAGE_NAMES = {
     8: "proxy",
     9: "transfer",
 }
+#: Batch flags (``SC_BATCH_*``).
+BATCH_MAPS, BATCH_POINTS, BATCH_NO_REPAIR = 1, 2, 4
 #: Transfer modes (``SC_TRANSFER_*``).
 TRANSFER_MODES = {"interpolate": 0, "nearest": 1, "weights": 2}

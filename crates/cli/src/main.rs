@@ -13,6 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use commands::batch::BatchArgs;
 use commands::bench::BenchCommand;
 use commands::demo::DemoArgs;
 use commands::eigen::EigenArgs;
@@ -69,6 +70,11 @@ enum Command {
     /// by nearest vertex (`nearest`: labels) or as skin weights (`weights`). The map's
     /// confidence and warning as `p2p`'s. See docs/transfer.md.
     Transfer(TransferArgs),
+    /// Many pairs of a shape collection (all pairs, one template against every shape, or a
+    /// pair file): each shape's eigenbasis computed once and cached, pairs in parallel, a
+    /// line per pair in OUT/pairs.jsonl as it finishes; a failed pair is a line with its
+    /// reason; running again resumes. See docs/collections.md.
+    Batch(BatchArgs),
     /// Benchmarks on the research datasets.
     Bench {
         #[command(subcommand)]
@@ -113,6 +119,7 @@ fn run(cli: &Cli) -> ExitCode {
         Command::Symmetry(args) => args.run(),
         Command::P2p(args) => args.run(),
         Command::Transfer(args) => args.run(),
+        Command::Batch(args) => args.run(),
         Command::Bench { which } => which.run(),
         Command::Demo(args) => args.run(),
     };

@@ -1,5 +1,6 @@
 //! One module per command: its arguments (a `clap::Args` struct) and its `run`.
 
+pub mod batch;
 pub mod bench;
 pub mod demo;
 pub mod eigen;
