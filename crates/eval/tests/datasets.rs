@@ -264,9 +264,13 @@ fn eigenbasis_cache_returns_the_same_basis_and_survives_damage() {
     let cache = BasisCache {
         dir: Some(root.join("cache")),
     };
-    let first = cache.basis(&path, &shape, "points=false|repair=true", &params).unwrap();
+    let first = cache
+        .basis(&path, &shape, "points=false|repair=true", &params)
+        .unwrap();
     assert!(!first.from_cache);
-    let second = cache.basis(&path, &shape, "points=false|repair=true", &params).unwrap();
+    let second = cache
+        .basis(&path, &shape, "points=false|repair=true", &params)
+        .unwrap();
     assert!(second.from_cache);
     assert_eq!(second.seconds, first.seconds, "the original time is kept");
     assert_eq!(first.basis.values, second.basis.values);
@@ -276,12 +280,18 @@ fn eigenbasis_cache_returns_the_same_basis_and_survives_damage() {
     // Other parameters or other file bytes: another key.
     let bytes = std::fs::read(&path).unwrap();
     let key = BasisCache::key(&bytes, "points=false|repair=true", &params);
-    assert_ne!(key, BasisCache::key(&bytes, "points=true|repair=true", &params));
+    assert_ne!(
+        key,
+        BasisCache::key(&bytes, "points=true|repair=true", &params)
+    );
     let more = EigenParams {
         n_eigenpairs: 21,
         ..params.clone()
     };
-    assert_ne!(key, BasisCache::key(&bytes, "points=false|repair=true", &more));
+    assert_ne!(
+        key,
+        BasisCache::key(&bytes, "points=false|repair=true", &more)
+    );
     let threads = EigenParams {
         threads: 1,
         ..params.clone()
@@ -293,13 +303,18 @@ fn eigenbasis_cache_returns_the_same_basis_and_survives_damage() {
     );
     let mut edited = bytes.clone();
     *edited.last_mut().unwrap() ^= 1;
-    assert_ne!(key, BasisCache::key(&edited, "points=false|repair=true", &params));
+    assert_ne!(
+        key,
+        BasisCache::key(&edited, "points=false|repair=true", &params)
+    );
     // A damaged cache file is recomputed, not trusted.
     let file = root.join("cache").join(format!("{key}.basis"));
     let len = std::fs::metadata(&file).unwrap().len();
     let f = std::fs::OpenOptions::new().write(true).open(&file).unwrap();
     f.set_len(len - 8).unwrap();
-    let third = cache.basis(&path, &shape, "points=false|repair=true", &params).unwrap();
+    let third = cache
+        .basis(&path, &shape, "points=false|repair=true", &params)
+        .unwrap();
     assert!(!third.from_cache);
     assert_eq!(third.basis.values, first.basis.values);
 }
