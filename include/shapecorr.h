@@ -191,11 +191,11 @@ typedef uint32_t sc_status;
 
 // The settings of a batch and the shapes it keeps prepared in memory. One per process is
 // enough: it may be used from several threads at once. Free it with `sc_batch_free`.
-typedef struct ScBatch ScBatch;
+typedef struct sc_batch sc_batch;
 
 // A batch log line: a shape's (`sc_batch_prepare`) or a pair's (`sc_batch_match`). Free
 // it with `sc_batch_record_free`.
-typedef struct ScBatchRecord ScBatchRecord;
+typedef struct sc_batch_record sc_batch_record;
 
 // The result of `sc_match`. Immutable: one handle may be read from several threads at
 // once. Free it with `sc_correspondence_free`.
@@ -262,13 +262,13 @@ uint32_t sc_abi_version(void);
 sc_status sc_batch_new(const sc_params *params,
                        const char *cache_dir,
                        uint32_t flags,
-                       ScBatch **out_batch);
+                       sc_batch **out_batch);
 
 // Frees a batch (NULL is a no-op).
 //
 // # Safety
 // `batch` NULL or live, and not used again.
-void sc_batch_free(ScBatch *batch);
+void sc_batch_free(sc_batch *batch);
 
 // The per-shape job: the shape in `path`, named `name` in the batch, read, its proxy built
 // when dense and its eigenbasis loaded from the cache or computed and stored. The record
@@ -278,10 +278,10 @@ void sc_batch_free(ScBatch *batch);
 //
 // # Safety
 // `batch` live; `name`, `path` NUL-terminated (UTF-8 name); `out_record` writable.
-sc_status sc_batch_prepare(const ScBatch *batch,
+sc_status sc_batch_prepare(const sc_batch *batch,
                            const char *name,
                            const char *path,
-                           ScBatchRecord **out_record);
+                           sc_batch_record **out_record);
 
 // The per-pair job: the regions (and with `SC_BATCH_MAPS` the map, written under
 // `out_dir/maps/`) of shapes A and B, each prepared as `sc_batch_prepare` (from memory or
@@ -292,32 +292,32 @@ sc_status sc_batch_prepare(const ScBatch *batch,
 //
 // # Safety
 // `batch` live; the strings NUL-terminated (UTF-8 names); `out_record` writable.
-sc_status sc_batch_match(const ScBatch *batch,
+sc_status sc_batch_match(const sc_batch *batch,
                          const char *name_a,
                          const char *path_a,
                          const char *name_b,
                          const char *path_b,
                          const char *out_dir,
-                         ScBatchRecord **out_record);
+                         sc_batch_record **out_record);
 
 // The record as one line of JSON (UTF-8, no newline). The string belongs to `record`:
 // valid until it is freed; never free it. NULL for NULL.
 //
 // # Safety
 // `record` NULL or live.
-const char *sc_batch_record_json(const ScBatchRecord *record);
+const char *sc_batch_record_json(const sc_batch_record *record);
 
 // Whether the record's job succeeded (false for NULL).
 //
 // # Safety
 // `record` NULL or live.
-bool sc_batch_record_ok(const ScBatchRecord *record);
+bool sc_batch_record_ok(const sc_batch_record *record);
 
 // Frees a record (NULL is a no-op).
 //
 // # Safety
 // `record` NULL or live, and not used again.
-void sc_batch_record_free(ScBatchRecord *record);
+void sc_batch_record_free(sc_batch_record *record);
 
 // A short static description of a status code (`"unknown status"` for a number that is
 // not a status). Never free it.

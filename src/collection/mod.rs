@@ -17,7 +17,7 @@
 pub mod cache;
 pub mod log;
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -183,6 +183,9 @@ pub struct PairRecord {
     pub map: Option<String>,
     /// Seconds of the pair's own work (the eigenbases were the shapes').
     pub seconds: f64,
+    /// Seconds per stage: `descriptors`, `segmentation`, `matching`, `one_to_one`, `proxies`
+    /// and, with maps, `map` (the functional map, its refinement and verification).
+    pub stages: BTreeMap<String, f64>,
 }
 
 /// A shape of a batch as [`Batch::prepare`] left it: prepared, or the reason it is not.
@@ -391,10 +394,23 @@ impl Batch {
                     if map.verdict.is_some() {
                         regions.verdict = map.verdict.clone();
                     }
+                    record
+                        .stages
+                        .insert("map".into(), map.timings.fmap + map.timings.refinement);
                     Ok((regions, Some(map.p2p_ba)))
                 })?
             }
         };
+        let t = &regions.timings;
+        for (stage, seconds) in [
+            ("descriptors", t.descriptors),
+            ("segmentation", t.segmentation),
+            ("matching", t.matching),
+            ("one_to_one", t.one_to_one),
+            ("proxies", t.proxies),
+        ] {
+            record.stages.insert(stage.into(), seconds);
+        }
         record.k = regions.k;
         record.n_regions_a = regions.graph_a.n_nodes();
         record.n_regions_b = regions.graph_b.n_nodes();

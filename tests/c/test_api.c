@@ -1180,6 +1180,87 @@ done:
     sc_shape_free(other);
 }
 
+/* ---------------------------------------------------------------- collections */
+
+/* Writes `shape` as an OFF file. */
+static void write_off(const sc_shape *shape, const char *path) {
+    size_t n = sc_shape_n_vertices(shape), t = sc_shape_n_triangles(shape), i;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    uint32_t *tri = malloc(3 * t * sizeof *tri);
+    FILE *f = fopen(path, "w");
+    CHECK(xyz && tri && f, "allocations and %s", path);
+    if (!(xyz && tri && f)) return;
+    CHECK_STATUS(sc_shape_vertices(shape, xyz, 3 * n), SC_STATUS_OK);
+    CHECK_STATUS(sc_shape_triangles(shape, tri, 3 * t), SC_STATUS_OK);
+    fprintf(f, "OFF\n%zu %zu 0\n", n, t);
+    for (i = 0; i < n; i++) fprintf(f, "%.17g %.17g %.17g\n", xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    for (i = 0; i < t; i++) fprintf(f, "3 %u %u %u\n", tri[3 * i], tri[3 * i + 1], tri[3 * i + 2]);
+    fclose(f);
+    free(xyz);
+    free(tri);
+}
+
+static void test_batch(void) {
+    char dir[] = "/tmp/shapecorr_c_batch_XXXXXX";
+    char a_path[128], b_path[128], cache[128], missing[128];
+    sc_batch *batch = NULL, *again = NULL;
+    sc_batch_record *record = NULL;
+    sc_correspondence *alone = NULL;
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 2);
+    const char *json;
+    char expected_k[32];
+    CHECK(mkdtemp(dir) != NULL, "temporary folder");
+    snprintf(a_path, sizeof a_path, "%s/a.off", dir);
+    snprintf(b_path, sizeof b_path, "%s/b.off", dir);
+    snprintf(cache, sizeof cache, "%s/cache", dir);
+    snprintf(missing, sizeof missing, "%s/missing.ply", dir);
+    write_off(a, a_path);
+    write_off(b, b_path);
+
+    CHECK_STATUS(sc_batch_new(NULL, cache, 0, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_batch_new(NULL, NULL, 0, &batch), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_batch_new(NULL, cache, 64, &batch), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_batch_new(NULL, cache, 0, &batch), SC_STATUS_OK);
+
+    /* The per-shape job: computed once, then from the cache (in another batch too). */
+    CHECK_STATUS(sc_batch_prepare(batch, "a", a_path, &record), SC_STATUS_OK);
+    CHECK(sc_batch_record_ok(record), "a prepared: %s", sc_batch_record_json(record));
+    CHECK(strstr(sc_batch_record_json(record), "\"computed\":true") != NULL, "%s",
+          sc_batch_record_json(record));
+    sc_batch_record_free(record);
+    CHECK_STATUS(sc_batch_new(NULL, cache, 0, &again), SC_STATUS_OK);
+    CHECK_STATUS(sc_batch_prepare(again, "a", a_path, &record), SC_STATUS_OK);
+    CHECK(strstr(sc_batch_record_json(record), "\"computed\":false") != NULL, "%s",
+          sc_batch_record_json(record));
+    sc_batch_record_free(record);
+    sc_batch_free(again);
+
+    /* The per-pair job: the answer of sc_match on the same shapes. */
+    CHECK_STATUS(sc_batch_match(batch, "a", a_path, "b", b_path, dir, &record), SC_STATUS_OK);
+    json = sc_batch_record_json(record);
+    CHECK(sc_batch_record_ok(record) && strstr(json, "\"ok\":true") != NULL, "%.200s", json);
+    CHECK_STATUS(sc_match(a, b, NULL, NULL, NULL, &alone), SC_STATUS_OK);
+    snprintf(expected_k, sizeof expected_k, "\"k\":%u,", sc_correspondence_k(alone));
+    CHECK(strstr(json, expected_k) != NULL, "%s in %.200s", expected_k, json);
+    sc_correspondence_free(alone);
+    sc_batch_record_free(record);
+
+    /* A shape that cannot be read: a failed record naming the file, not a failed call. */
+    CHECK_STATUS(sc_batch_match(batch, "a", a_path, "gone", missing, dir, &record), SC_STATUS_OK);
+    CHECK(!sc_batch_record_ok(record), "a missing file fails the pair");
+    CHECK(strstr(sc_batch_record_json(record), "missing.ply") != NULL, "%s",
+          sc_batch_record_json(record));
+    sc_batch_record_free(record);
+    CHECK_STATUS(sc_batch_match(batch, NULL, a_path, "b", b_path, dir, &record),
+                 SC_STATUS_NULL_ARGUMENT);
+    CHECK(sc_batch_record_json(NULL) == NULL && !sc_batch_record_ok(NULL), "NULL record");
+    sc_batch_record_free(NULL);
+    sc_batch_free(NULL);
+    sc_batch_free(batch);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
 int main(void) {
     const char *q = getenv("SHAPECORR_TEST_QUICK");
     quick = q != NULL && strcmp(q, "1") == 0;
@@ -1201,6 +1282,7 @@ int main(void) {
     test_pointwise_permuted_copy();
     test_pointwise_cancellation();
     test_transfer();
+    test_batch();
     test_concurrency();
     printf("%d checks, %d failures%s\n", checks, failures, quick ? " (quick)" : "");
     return failures == 0 ? 0 : 1;

@@ -16,7 +16,7 @@ from shapecorr import batch
 
 SIZE = 1000
 #: What may differ between two runs of one pair: the time it took.
-TIMING = ("seconds",)
+TIMING = ("seconds", "stages")
 
 
 def write_off(path, shape):
