@@ -105,6 +105,10 @@ pub struct PreparedShape {
     pub proxy: Option<Proxy>,
     /// The eigenbasis of the working shape (the proxy's, or the shape's).
     pub basis: Eigenbasis,
+    /// Its cache key.
+    pub basis_key: String,
+    /// Seconds the eigenbasis took when it was computed.
+    pub eigenbasis_s: f64,
 }
 
 impl PreparedShape {
@@ -242,6 +246,8 @@ impl Batch {
             record.ok = true;
             record.vertices = shape.shape.n_vertices();
             record.working_vertices = shape.working().n_vertices();
+            record.key = shape.basis_key.clone();
+            record.eigenbasis_s = shape.eigenbasis_s;
             return (Ok(shape), record);
         }
         let prepared = self.prepare_file(path, &mut record).map(Arc::new);
@@ -287,6 +293,8 @@ impl Batch {
             shape,
             proxy,
             basis: timed.basis,
+            basis_key: record.key.clone(),
+            eigenbasis_s: timed.seconds,
         })
     }
 
