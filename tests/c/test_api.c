@@ -1206,6 +1206,8 @@ static void test_batch(void) {
     sc_batch *batch = NULL, *again = NULL;
     sc_batch_record *record = NULL;
     sc_correspondence *alone = NULL;
+    sc_params *params = NULL;
+    char command[160];
     sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 2);
     const char *json;
     char expected_k[32];
@@ -1217,10 +1219,17 @@ static void test_batch(void) {
     write_off(a, a_path);
     write_off(b, b_path);
 
-    CHECK_STATUS(sc_batch_new(NULL, cache, 0, NULL), SC_STATUS_NULL_ARGUMENT);
-    CHECK_STATUS(sc_batch_new(NULL, NULL, 0, &batch), SC_STATUS_NULL_ARGUMENT);
-    CHECK_STATUS(sc_batch_new(NULL, cache, 64, &batch), SC_STATUS_INVALID_ARGUMENT);
-    CHECK_STATUS(sc_batch_new(NULL, cache, 0, &batch), SC_STATUS_OK);
+    /* A cheap pipeline (this tests the API; under valgrind the defaults took minutes). */
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "k_max", 5), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "eigenpairs", 30), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_bool(params, "verify_hypotheses", false), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_bool(params, "hks_fallback", false), SC_STATUS_OK);
+
+    CHECK_STATUS(sc_batch_new(params, cache, 0, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_batch_new(params, NULL, 0, &batch), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_batch_new(params, cache, 64, &batch), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_batch_new(params, cache, 0, &batch), SC_STATUS_OK);
 
     /* The per-shape job: computed once, then from the cache (in another batch too). */
     CHECK_STATUS(sc_batch_prepare(batch, "a", a_path, &record), SC_STATUS_OK);
@@ -1228,7 +1237,7 @@ static void test_batch(void) {
     CHECK(strstr(sc_batch_record_json(record), "\"computed\":true") != NULL, "%s",
           sc_batch_record_json(record));
     sc_batch_record_free(record);
-    CHECK_STATUS(sc_batch_new(NULL, cache, 0, &again), SC_STATUS_OK);
+    CHECK_STATUS(sc_batch_new(params, cache, 0, &again), SC_STATUS_OK);
     CHECK_STATUS(sc_batch_prepare(again, "a", a_path, &record), SC_STATUS_OK);
     CHECK(strstr(sc_batch_record_json(record), "\"computed\":false") != NULL, "%s",
           sc_batch_record_json(record));
@@ -1239,7 +1248,7 @@ static void test_batch(void) {
     CHECK_STATUS(sc_batch_match(batch, "a", a_path, "b", b_path, dir, &record), SC_STATUS_OK);
     json = sc_batch_record_json(record);
     CHECK(sc_batch_record_ok(record) && strstr(json, "\"ok\":true") != NULL, "%.200s", json);
-    CHECK_STATUS(sc_match(a, b, NULL, NULL, NULL, &alone), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, b, params, NULL, NULL, &alone), SC_STATUS_OK);
     snprintf(expected_k, sizeof expected_k, "\"k\":%u,", sc_correspondence_k(alone));
     CHECK(strstr(json, expected_k) != NULL, "%s in %.200s", expected_k, json);
     sc_correspondence_free(alone);
@@ -1257,8 +1266,11 @@ static void test_batch(void) {
     sc_batch_record_free(NULL);
     sc_batch_free(NULL);
     sc_batch_free(batch);
+    sc_params_free(params);
     sc_shape_free(a);
     sc_shape_free(b);
+    snprintf(command, sizeof command, "rm -rf '%s'", dir);
+    CHECK(system(command) == 0, "%s", command);
 }
 
 int main(void) {
