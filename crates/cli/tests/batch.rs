@@ -9,12 +9,9 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-fn shapecorr(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_shapecorr"))
-        .args(args)
-        .output()
-        .expect("the shapecorr binary runs")
-}
+mod common;
+
+use common::shapecorr;
 
 fn ok(out: std::process::Output) -> String {
     assert!(
@@ -26,10 +23,7 @@ fn ok(out: std::process::Output) -> String {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("shapecorr-batch-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("batch", name)
 }
 
 fn s(path: &Path) -> &str {

@@ -1,39 +1,13 @@
 //! The command-line tool end to end: real processes, real files.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn shapecorr(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_shapecorr"))
-        .args(args)
-        .output()
-        .expect("the shapecorr binary runs")
-}
+mod common;
+
+use common::{shapecorr, synth_figure};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("shapecorr-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Writes a generated figure (`shapecorr synth`) to `path` and checks that it worked.
-fn synth_figure(kind: &str, pose: &str, vertices: &str, path: &Path) {
-    let out = shapecorr(&[
-        "synth",
-        "--kind",
-        kind,
-        "--pose",
-        pose,
-        "--vertices",
-        vertices,
-        "--out",
-        path.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::scratch("cli", name)
 }
 
 /// The keys of `result.json` that say how sure the answer is: `confidence` a number in

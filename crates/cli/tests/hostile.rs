@@ -7,12 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn shapecorr<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shapecorr"))
-        .args(args)
-        .output()
-        .expect("the shapecorr binary runs")
-}
+mod common;
+
+use common::shapecorr;
 
 /// Runs shapecorr, killing it after `limit`; `None` when it had to be killed.
 fn shapecorr_within<S: AsRef<std::ffi::OsStr>>(args: &[S], limit: Duration) -> Option<Output> {
@@ -35,9 +32,7 @@ fn shapecorr_within<S: AsRef<std::ffi::OsStr>>(args: &[S], limit: Duration) -> O
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("shapecorr-hostile-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("hostile", name)
 }
 
 fn synth(path: &Path, pose: &str) {
