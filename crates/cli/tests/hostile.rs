@@ -36,22 +36,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn synth(path: &Path, pose: &str) {
-    let out = shapecorr(&[
-        "synth",
-        "--kind",
-        "humanoid",
-        "--pose",
-        pose,
-        "--vertices",
-        "800",
-        "--out",
-        path.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::synth_figure("humanoid", pose, "800", path);
 }
 
 fn stderr(out: &Output) -> String {
