@@ -23,6 +23,8 @@ REPOSITORY = HERE.parent
 SOURCE = HERE / "shapecorr_blender"
 BINDING = REPOSITORY / "bindings" / "python" / "shapecorr"
 LIBRARY_NAMES = {"linux": "libshapecorr.so", "darwin": "libshapecorr.dylib", "win32": "shapecorr.dll"}
+# The manifest's licence (GPL-3.0-or-later, as Blender asks of add-ons) and the project's own.
+LICENCES = [HERE / "LICENSE-GPL-3.0", REPOSITORY / "LICENSE-MIT", REPOSITORY / "LICENSE-APACHE"]
 
 
 def blender_platform():
@@ -57,6 +59,8 @@ def build(library=None, out=None):
         for path in sorted(BINDING.glob("*.py")):
             archive.write(path, f"shapecorr/{path.name}")
         archive.write(library, f"shapecorr/{name}")
+        for path in LICENCES:
+            archive.write(path, path.name)
     return zip_path
 
 

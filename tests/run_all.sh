@@ -1,15 +1,19 @@
 #!/usr/bin/env bash
 # Runs every test of the project: the layout limits (tests/layout/check.py: modules at most
-# 1,200 lines, functions at most 150), the Rust unit, integration and documentation tests of
-# the workspace (the pipeline crate, crates/eval, crates/cli)
-# (library, file readers, generated figures, spectral identities, region correspondence,
-# command line, the C header's drift check), the C API's tests (plain, AddressSanitizer +
-# UndefinedBehaviorSanitizer, valgrind; C++ wrapper; example programs) and the Python
-# binding's tests (installed with pip into target/py-venv), and the Blender extension and
-# MeshLab script headless (bpy and pymeshlab from PyPI, in target/blender-venv), and a short
-# run of every fuzz target (tests/fuzz/run.sh: 10 s each; cargo-fuzz installed if missing).
-# Needs the Rust toolchain, gcc/g++ and python3; installs numpy and pytest into the venv,
-# bpy and pymeshlab into the venvs, and valgrind with apt-get if it is missing.
+# 1,200 lines, functions at most 150); the Rust unit, integration and documentation tests of
+# the workspace (the pipeline crate, crates/eval, crates/cli: library, file readers,
+# generated figures, spectral identities, region correspondence, command line, the C
+# header's drift check); the C API's tests (plain, AddressSanitizer +
+# UndefinedBehaviorSanitizer, valgrind; C++ wrapper; example programs); the C/C++ install
+# (tests/install/run.sh: `cargo cinstall` into a temporary prefix, then the README's C and
+# C++ examples built with pkg-config and with CMake); the Python binding's tests (its wheel
+# built, repaired and installed into a fresh target/py-venv); the Blender extension and
+# MeshLab script headless (bpy and pymeshlab from PyPI, in target/blender-venv); and a short
+# run of every fuzz target (tests/fuzz/run.sh: 10 s each).
+# Needs the Rust toolchain, gcc/g++ and python3. Installs what is missing: cargo-c and
+# cargo-fuzz with cargo; valgrind, cmake and pkg-config with apt-get; numpy, pytest, dask,
+# matplotlib, mypy and trimesh into the test venv, auditwheel into the wheel's build venv,
+# bpy and pymeshlab into the Blender venv.
 # Tests that need the benchmark data (../shared/data or $SHAPECORR_DATA) skip cleanly
 # without it.
 set -euo pipefail
@@ -20,5 +24,6 @@ cargo test --release --locked --workspace --all-targets
 cargo test --release --locked --workspace --doc
 bash tests/fuzz/run.sh
 bash tests/c/run.sh
+bash tests/install/run.sh
 bash tests/python/run.sh
 bash tests/blender/run.sh

@@ -301,7 +301,7 @@ def test_settings_default_to_the_library_defaults(addon):
         assert getattr(settings, name) == defaults[name], name
 
 
-def test_the_extension_ships_a_small_library():
+def test_the_extension_ships_a_small_library_and_its_licences():
     zip_path = os.environ.get("SHAPECORR_BLENDER_ZIP")
     if zip_path is None:
         pytest.skip("needs the zip built by tests/blender/run.sh")
@@ -313,6 +313,15 @@ def test_the_extension_ships_a_small_library():
     assert library, sorted(sizes)
     # Built with the `dist` profile, no debug information (issue 17: at most 8 MB).
     assert sizes[library[0]] <= 8 * 1024 * 1024, sizes[library[0]]
+    # The manifest's licence and the project's two travel with it (issue 23).
+    with zipfile.ZipFile(zip_path) as archive:
+        manifest = archive.read("blender_manifest.toml").decode()
+        licences = {name: archive.read(name).decode() for name in
+                    ("LICENSE-GPL-3.0", "LICENSE-MIT", "LICENSE-APACHE")}
+    assert 'license = ["SPDX:GPL-3.0-or-later"]' in manifest
+    assert "GNU GENERAL PUBLIC LICENSE" in licences["LICENSE-GPL-3.0"]
+    assert "Permission is hereby granted" in licences["LICENSE-MIT"]
+    assert "Apache License" in licences["LICENSE-APACHE"]
 
 
 def test_render_the_coloured_figures_with_cycles(addon, tmp_path):

@@ -13,14 +13,17 @@ A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
     result.warning              # a sentence when the answer is doubtful, else None
     pointwise = shapecorr.pointwise_map(a, b)
     pointwise.map_b_to_a        # vertex of A for every vertex of B (numpy uint32)
+    shapecorr.Shape.from_trimesh(mesh)   # also from_open3d, from_mesh (vertices, faces)
     onto = shapecorr.surface_map(a, b, pointwise)
     onto.transfer(weights_a, mode="weights", max_influences=4)   # A's data on B
 
 Options are the library's named options (``shapecorr.options()``), with the same defaults as
 the command line. Errors raise :class:`ShapecorrError` with the C status and the message.
 Shapes and results may be shared between threads; the library releases the GIL while it
-works (ctypes does).
+works (ctypes does). The package is typed (PEP 561): arrays are ``numpy.typing.NDArray``.
 """
+
+from __future__ import annotations
 
 import ctypes
 import functools
@@ -29,8 +32,10 @@ import os
 import signal
 import threading
 import weakref
+from typing import Any, Callable, Iterable, Literal, TypedDict, Union
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _lib
 from ._lib import lib
@@ -49,14 +54,40 @@ __all__ = [
     "options",
     "version",
     "CONFIDENCE_DOUBTFUL_BELOW",
+    "REPAIRS",
+    "RegionGraph",
+    "OptionKind",
+    "OptionValue",
+    "ProgressCallback",
+    "RepairSpec",
+    "Side",
+    "StrPath",
+    "TransferMode",
 ]
+
+# Type aliases of the public API (strings inside: numpy's generic scalar types cannot be
+# subscripted at run time before numpy 1.22).
+#: A named option's value (see :func:`options`).
+OptionValue = Union[bool, int, float, "np.integer[Any]", "np.floating[Any]", "np.bool_"]
+#: ``progress(stage_name, fraction)``: a falsy return other than None cancels.
+ProgressCallback = Callable[[str, float], object]
+#: ``repair`` of the shape constructors: True, False (or None), or names from :data:`REPAIRS`.
+RepairSpec = Union[bool, None, Iterable[str]]
+#: One side of a result: ``"a"`` (or ``"A"``, ``0``) or ``"b"`` (``"B"``, ``1``).
+Side = Literal["a", "A", 0, "b", "B", 1]
+#: A file path as ``open`` takes it.
+StrPath = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]
+#: The kinds of :func:`options`.
+OptionKind = Literal["int", "float", "bool"]
+#: The modes of :meth:`SurfaceMap.transfer`.
+TransferMode = Literal["interpolate", "nearest", "weights"]
 
 
 class ShapecorrError(Exception):
     """A failed call: ``status`` is the C status code, ``status_name`` its name (e.g.
     ``"NON_FINITE_COORDINATE"``), ``message`` the library's explanation."""
 
-    def __init__(self, status, message):
+    def __init__(self, status: int, message: str) -> None:
         self.status = int(status)
         self.status_name = _lib.STATUS_NAMES.get(self.status, "UNKNOWN")
         self.message = message
@@ -73,7 +104,7 @@ def _check(status):
 CONFIDENCE_DOUBTFUL_BELOW = _lib.CONFIDENCE_DOUBTFUL_BELOW
 
 
-def version():
+def version() -> str:
     """The library's version string (the same as ``__version__``)."""
     return lib.sc_version().decode()
 
@@ -109,11 +140,11 @@ class _Handle:
         return self._pointer
 
     @property
-    def closed(self):
+    def closed(self) -> bool:
         """True once :meth:`close` freed the C object."""
         return not self._finalizer.alive
 
-    def close(self):
+    def close(self) -> None:
         """Frees the C object now (also done automatically); using it afterwards raises
         ValueError."""
         self._finalizer()
@@ -136,13 +167,14 @@ def _new_handle(constructor, *args):
 
 class Shape(_Handle):
     """A validated triangle mesh or point cloud (immutable; safe to share between
-    threads). Make one with :meth:`mesh`, :meth:`point_cloud`, :meth:`read` or
-    :meth:`figure`."""
+    threads). Make one with :meth:`mesh`, :meth:`point_cloud`, :meth:`read`,
+    :meth:`figure`, or from another library's object with :meth:`from_trimesh`,
+    :meth:`from_open3d` or :meth:`from_mesh`."""
 
     _free = lib.sc_shape_free
 
     @classmethod
-    def mesh(cls, vertices, triangles, repair=True):
+    def mesh(cls, vertices: ArrayLike, triangles: ArrayLike, repair: RepairSpec = True) -> Shape:
         """A mesh from an (n, 3) array of vertices and an (m, 3) array of 0-based triangle
         indices (copied; float32 coordinates stay float32 on the way in).
 
@@ -174,7 +206,7 @@ class Shape(_Handle):
         )
 
     @classmethod
-    def point_cloud(cls, points, repair=True):
+    def point_cloud(cls, points: ArrayLike, repair: RepairSpec = True) -> Shape:
         """A point cloud from an (n, 3) array of points (copied). ``repair`` as for
         :meth:`mesh` (coincident points welded, far and isolated points and small loose
         clusters left out)."""
@@ -188,7 +220,7 @@ class Shape(_Handle):
         return cls(_new_handle(function, _ptr(coords, ctype), len(coords)))
 
     @classmethod
-    def read(cls, path, as_point_cloud=False, repair=True):
+    def read(cls, path: StrPath, as_point_cloud: bool = False, repair: RepairSpec = True) -> Shape:
         """Reads OFF, OBJ, PLY or XYZ; a file without faces gives a point cloud. ``repair``
         as for :meth:`mesh`."""
         # os.fsencode: str, bytes or path-like, with the file system's encoding; a NUL
@@ -201,23 +233,78 @@ class Shape(_Handle):
         )
 
     @classmethod
-    def figure(cls, kind="humanoid", pose=0, vertices=5000):
+    def figure(cls, kind: str = "humanoid", pose: int = 0, vertices: int = 5000) -> Shape:
         """A generated figure (``"humanoid"``, ``"quadruped"``, ``"star3"``..``"star8"``);
         every pose of a kind and size shares the vertex order (a ground truth)."""
         if not isinstance(kind, str):
             raise TypeError(f"kind must be a str, got {type(kind).__name__}")
         return cls(_new_handle(lib.sc_shape_new_figure, kind.encode(), pose, vertices))
 
+    @classmethod
+    def from_mesh(cls, mesh: object, repair: RepairSpec = True) -> Shape:
+        """A shape from any object with ``vertices`` ((n, 3) coordinates) and, for a mesh,
+        ``faces`` (or ``triangles``: (m, 3) vertex indices), each an array or anything
+        ``numpy.asarray`` takes. Without faces (no attribute, None or no rows) it is a point
+        cloud, as a file without faces is. ``repair`` as for :meth:`mesh`; nothing else
+        (colours, normals) is read."""
+        vertices = getattr(mesh, "vertices", None)
+        if vertices is None:
+            hint = " (an Open3D point cloud? use Shape.from_open3d)" if hasattr(mesh, "points") else ""
+            raise TypeError(
+                "expected an object with `vertices` (and `faces` for a mesh), got "
+                f"{type(mesh).__name__}{hint}"
+            )
+        faces = getattr(mesh, "faces", None)
+        if faces is None:
+            faces = getattr(mesh, "triangles", None)
+        faces = None if faces is None else np.asarray(faces)
+        if faces is not None and faces.size:
+            return cls.mesh(vertices, faces, repair)
+        return cls.point_cloud(vertices, repair)
+
+    @classmethod
+    def from_trimesh(cls, mesh: object, repair: RepairSpec = True) -> Shape:
+        """A shape from a ``trimesh.Trimesh`` (a mesh; one without faces is a point cloud)
+        or a ``trimesh.PointCloud``; trimesh itself is not needed here. A ``trimesh.Scene``
+        (what ``trimesh.load`` gives for a file of several parts) raises TypeError: load it
+        with ``trimesh.load(path, force="mesh")`` to get one mesh."""
+        parts = getattr(mesh, "geometry", None)
+        if getattr(mesh, "vertices", None) is None and isinstance(parts, dict):
+            raise TypeError(
+                f"got a scene of {len(parts)} geometries, not one mesh: load the file with "
+                'trimesh.load(path, force="mesh"), or pass one of scene.geometry\'s values'
+            )
+        return cls.from_mesh(mesh, repair)
+
+    @classmethod
+    def from_open3d(cls, geometry: object, repair: RepairSpec = True) -> Shape:
+        """A shape from an Open3D ``TriangleMesh`` (``vertices``, ``triangles``; one
+        without triangles is a point cloud) or ``PointCloud`` (``points``), of the legacy
+        (``open3d.geometry``) or the tensor API (``open3d.t.geometry``, converted with
+        ``to_legacy()``); Open3D itself is not needed here."""
+        to_legacy = getattr(geometry, "to_legacy", None)
+        if callable(to_legacy):
+            geometry = to_legacy()
+        if getattr(geometry, "vertices", None) is not None:
+            return cls.from_mesh(geometry, repair)
+        points = getattr(geometry, "points", None)
+        if points is None:
+            raise TypeError(
+                "expected an Open3D TriangleMesh (vertices, triangles) or PointCloud (points), "
+                f"got {type(geometry).__name__}"
+            )
+        return cls.point_cloud(points, repair)
+
     @property
-    def n_vertices(self):
+    def n_vertices(self) -> int:
         return lib.sc_shape_n_vertices(self)
 
     @property
-    def is_point_cloud(self):
+    def is_point_cloud(self) -> bool:
         return bool(lib.sc_shape_is_point_cloud(self))
 
     @property
-    def vertices(self):
+    def vertices(self) -> NDArray[np.float64]:
         """(n, 3) float64 array of the vertices, in the input order."""
         return _fill(
             lib.sc_shape_vertices, self, shape=(self.n_vertices, 3), dtype=np.float64,
@@ -225,24 +312,24 @@ class Shape(_Handle):
         )
 
     @property
-    def triangles(self):
+    def triangles(self) -> NDArray[np.uint32]:
         """(m, 3) uint32 array of triangles (polygons split; empty for a point cloud)."""
         n = lib.sc_shape_n_triangles(self)
         return _fill(lib.sc_shape_triangles, self, shape=(n, 3), dtype=np.uint32, ctype=ctypes.c_uint32)
 
     @property
-    def warnings(self):
+    def warnings(self) -> list[str]:
         """What was repaired or is unusual (degenerate faces, pieces, ...), one string each."""
         return _lines(lib.sc_shape_warnings, self)
 
     @property
-    def repairs(self):
+    def repairs(self) -> list[str]:
         """The repairs made (coincident vertices welded, debris, far vertices or isolated
         points left out; see ``repair`` of :meth:`mesh`), one string each: a part of
         :attr:`warnings`."""
         return _lines(lib.sc_shape_repairs, self)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         kind = "point cloud" if self.is_point_cloud else "mesh"
         return f"<shapecorr.Shape {kind}, {self.n_vertices} vertices>"
 
@@ -256,7 +343,7 @@ def _lines(function, shape):
 
 
 #: The repairs by name (the C API's ``SC_REPAIR_*`` flags).
-REPAIRS = {"weld": 1, "debris": 2, "outliers": 4}
+REPAIRS: dict[str, int] = {"weld": 1, "debris": 2, "outliers": 4}
 _REPAIR_ALL = 7
 
 
@@ -322,17 +409,22 @@ class _Params(_Handle):
             _check(setter(self, name.encode(), converted))
 
 
-def options():
+_OPTION_KINDS: dict[int, OptionKind] = {
+    _lib.OPTION_INT: "int", _lib.OPTION_DOUBLE: "float", _lib.OPTION_BOOL: "bool"
+}
+
+
+def options() -> list[tuple[str, OptionKind, str, int | float | bool]]:
     """Every option as ``(name, type, description, default)``; type is ``"int"``,
     ``"float"`` or ``"bool"``. The defaults are the library's (the same everywhere)."""
     defaults = ctypes.c_void_p()
     _check(lib.sc_params_new(ctypes.byref(defaults)))
     try:
-        result = []
+        result: list[tuple[str, OptionKind, str, int | float | bool]] = []
         for i in range(lib.sc_option_count()):
             name = lib.sc_option_name(i)
-            kind = {0: "int", 1: "float", 2: "bool"}[lib.sc_option_type(i)]
-            value = {"int": ctypes.c_int64, "float": ctypes.c_double, "bool": ctypes.c_bool}[kind]()
+            kind = _OPTION_KINDS[lib.sc_option_type(i)]
+            value: Any = {"int": ctypes.c_int64, "float": ctypes.c_double, "bool": ctypes.c_bool}[kind]()
             getter = {
                 "int": lib.sc_params_get_int,
                 "float": lib.sc_params_get_double,
@@ -415,31 +507,42 @@ def _side(side):
     raise ValueError(f"side must be 'a' or 'b', got {side!r}")
 
 
+class RegionGraph(TypedDict):
+    """One side's shape graph (:meth:`Correspondence.graph`)."""
+
+    #: Fraction of the shape's area per region.
+    areas: NDArray[np.float64]
+    #: Mean heat kernel signature per region, (n_regions, descriptor length).
+    descriptors: NDArray[np.float64]
+    #: (e, 2): regions that touch.
+    edges: NDArray[np.uint32]
+
+
 class Correspondence(_Handle):
     """The result of :func:`match` (immutable; safe to share between threads)."""
 
     _free = lib.sc_correspondence_free
 
     @property
-    def k(self):
+    def k(self) -> int:
         """The number of joint clusters chosen."""
         return lib.sc_correspondence_k(self)
 
-    def n_regions(self, side):
+    def n_regions(self, side: Side) -> int:
         return lib.sc_correspondence_n_regions(self, _side(side))
 
-    def regions(self, side):
+    def regions(self, side: Side) -> NDArray[np.uint32]:
         """Region id of every vertex of one side (``"a"`` or ``"b"``), input order."""
         s = _side(side)
         n = lib.sc_correspondence_n_vertices(self, s)
         return _fill(lib.sc_correspondence_regions, self, s, shape=n, dtype=np.uint32, ctype=ctypes.c_uint32)
 
     @property
-    def regions_a(self):
+    def regions_a(self) -> NDArray[np.uint32]:
         return self.regions("a")
 
     @property
-    def regions_b(self):
+    def regions_b(self) -> NDArray[np.uint32]:
         return self.regions("b")
 
     def _matches(self, kind):
@@ -450,16 +553,16 @@ class Correspondence(_Handle):
         )
 
     @property
-    def matches(self):
+    def matches(self) -> NDArray[np.uint32]:
         """Symmetric matches: (n, 2) array of (region of A, region of B)."""
         return self._matches(_lib.MATCHES_SYMMETRIC)
 
     @property
-    def matches_one_to_one(self):
+    def matches_one_to_one(self) -> NDArray[np.uint32]:
         """One-to-one matches after symmetry breaking (empty if ``one_to_one=False``)."""
         return self._matches(_lib.MATCHES_ONE_TO_ONE)
 
-    def colors(self, side, one_to_one=True):
+    def colors(self, side: Side, one_to_one: bool = True) -> NDArray[np.uint8]:
         """(n_vertices, 4) uint8 RGBA of one side: matched regions share a colour on both
         shapes, unmatched regions are dark grey."""
         s = _side(side)
@@ -467,7 +570,7 @@ class Correspondence(_Handle):
         n = lib.sc_correspondence_n_vertices(self, s)
         return _fill(lib.sc_correspondence_colors, self, s, kind, shape=(n, 4), dtype=np.uint8, ctype=ctypes.c_uint8)
 
-    def graph(self, side):
+    def graph(self, side: Side) -> RegionGraph:
         """One side's shape graph: ``areas`` (fraction of the shape's area per region),
         ``descriptors`` (mean HKS per region) and ``edges`` ((e, 2) array, regions that
         touch)."""
@@ -485,7 +588,7 @@ class Correspondence(_Handle):
         }
 
     @property
-    def confidence(self):
+    def confidence(self) -> float | None:
         """The confidence of the one-to-one answer, a float in [0, 1] (below
         ``CONFIDENCE_DOUBTFUL_BELOW``, 0.45, the answer is doubtful), or None when it was not
         verified (``verify_hypotheses=False``, ``one_to_one=False``, or nothing to choose
@@ -493,17 +596,17 @@ class Correspondence(_Handle):
         return _confidence(lib.sc_correspondence_confidence(self))
 
     @property
-    def warning(self):
+    def warning(self) -> str | None:
         """What to tell the user when the answer is doubtful (one sentence), else None."""
         return _warning(lib.sc_correspondence_warning(self))
 
     @property
-    def doubtful(self):
+    def doubtful(self) -> bool:
         """True when the answer has a confidence below ``CONFIDENCE_DOUBTFUL_BELOW``."""
         return self.warning is not None
 
     @property
-    def timings(self):
+    def timings(self) -> dict[str, float]:
         """Seconds per stage, and ``total``."""
         out = {}
         for stage in (
@@ -522,31 +625,34 @@ class Symmetry(_Handle):
     _free = lib.sc_symmetry_free
 
     @property
-    def regions(self):
+    def regions(self) -> NDArray[np.uint32]:
+        """Region of every vertex."""
         n = lib.sc_symmetry_n_vertices(self)
         return _fill(lib.sc_symmetry_regions, self, shape=n, dtype=np.uint32, ctype=ctypes.c_uint32)
 
     @property
-    def region_groups(self):
+    def region_groups(self) -> NDArray[np.uint32]:
         """Group of every region: regions of one group are symmetric copies."""
         n = lib.sc_symmetry_n_regions(self)
         return _fill(lib.sc_symmetry_region_groups, self, shape=n, dtype=np.uint32, ctype=ctypes.c_uint32)
 
     @property
-    def groups(self):
+    def groups(self) -> list[list[int]]:
         """List of groups, each a sorted list of regions."""
-        groups = [[] for _ in range(lib.sc_symmetry_n_groups(self))]
+        groups: list[list[int]] = [[] for _ in range(lib.sc_symmetry_n_groups(self))]
         for region, group in enumerate(self.region_groups):
             groups[group].append(region)
         return groups
 
-    def colors(self):
+    def colors(self) -> NDArray[np.uint8]:
         """(n_vertices, 4) uint8 RGBA: a symmetric group shares a colour, others dark grey."""
         n = lib.sc_symmetry_n_vertices(self)
         return _fill(lib.sc_symmetry_colors, self, shape=(n, 4), dtype=np.uint8, ctype=ctypes.c_uint8)
 
 
-def match(a, b, progress=None, **options):
+def match(
+    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: OptionValue
+) -> Correspondence:
     """Region correspondence between shapes ``a`` and ``b``. ``options`` are named options
     (``k_min=5, k_max=10, one_to_one=True, ...``; see :func:`options`). ``progress``, if
     given, is called as ``progress(stage, fraction)`` at least every 0.2 s and cancels by
@@ -558,7 +664,9 @@ def match(a, b, progress=None, **options):
     return Correspondence(_Progress(progress).run(lib.sc_match, a, b, params))
 
 
-def detect_symmetry(shape, progress=None, **options):
+def detect_symmetry(
+    shape: Shape, progress: ProgressCallback | None = None, **options: OptionValue
+) -> Symmetry:
     """Groups of mutually symmetric regions of one shape (arguments as :func:`match`)."""
     _expect(shape, Shape, "shape")
     params = _Params(options)
@@ -571,15 +679,15 @@ class PointwiseMap(_Handle):
     _free = lib.sc_pointwise_free
 
     @property
-    def n_vertices_a(self):
+    def n_vertices_a(self) -> int:
         return lib.sc_pointwise_n_vertices(self, _lib.SIDE_A)
 
     @property
-    def n_vertices_b(self):
+    def n_vertices_b(self) -> int:
         return lib.sc_pointwise_n_vertices(self, _lib.SIDE_B)
 
     @property
-    def map_b_to_a(self):
+    def map_b_to_a(self) -> NDArray[np.uint32]:
         """For every vertex of B (input order), the vertex of A it corresponds to: a uint32
         array of ``n_vertices_b`` values below ``n_vertices_a``."""
         return _fill(
@@ -588,37 +696,37 @@ class PointwiseMap(_Handle):
         )
 
     @property
-    def fmap(self):
+    def fmap(self) -> NDArray[np.float64]:
         """The functional map from A to B, a (k_b, k_a) float64 array: it takes a function's
         coefficients in A's Laplacian eigenbasis to the transported function's on B."""
         rows, cols = lib.sc_pointwise_fmap_rows(self), lib.sc_pointwise_fmap_cols(self)
         return _fill(lib.sc_pointwise_fmap, self, shape=(rows, cols), dtype=np.float64, ctype=ctypes.c_double)
 
     @property
-    def confidence(self):
+    def confidence(self) -> float | None:
         """The confidence of the answer, a float in [0, 1]: of the map's own choice among
         region hypotheses when it verified several (``p2p_orientation``,
         ``p2p_hypotheses``), else of its :attr:`regions`; None when nothing was verified."""
         return _confidence(lib.sc_pointwise_confidence(self))
 
     @property
-    def warning(self):
+    def warning(self) -> str | None:
         """What to tell the user when the answer is doubtful (one sentence), else None."""
         return _warning(lib.sc_pointwise_warning(self))
 
     @property
-    def doubtful(self):
+    def doubtful(self) -> bool:
         """True when the answer has a confidence below ``CONFIDENCE_DOUBTFUL_BELOW``."""
         return self.warning is not None
 
     @functools.cached_property
-    def regions(self):
+    def regions(self) -> Correspondence:
         """The region correspondence the map was built on (a :class:`Correspondence`; its
         timings count the region stages only)."""
         return Correspondence(_new_handle(lib.sc_pointwise_regions, self))
 
     @property
-    def timings(self):
+    def timings(self) -> dict[str, float]:
         """Seconds per stage: ``eigenbasis_a``, ``eigenbasis_b``, ``regions``, ``fmap``,
         ``refinement`` and ``total``."""
         out = {}
@@ -628,11 +736,13 @@ class PointwiseMap(_Handle):
             out[stage] = value.value
         return out
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"<shapecorr.PointwiseMap {self.n_vertices_b} vertices of B -> {self.n_vertices_a} of A>"
 
 
-def pointwise_map(a, b, progress=None, **options):
+def pointwise_map(
+    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: OptionValue
+) -> PointwiseMap:
     """Point-to-point map from shape ``b`` to shape ``a``: the region correspondence of
     :func:`match`, then a functional map constrained by the matched regions, refined by
     ZoomOut. ``options`` are named options as for :func:`match`, plus the pointwise map's
@@ -652,15 +762,15 @@ class SurfaceMap(_Handle):
     _free = lib.sc_surface_map_free
 
     @property
-    def n_vertices_a(self):
+    def n_vertices_a(self) -> int:
         return lib.sc_surface_map_n_vertices(self, _lib.SIDE_A)
 
     @property
-    def n_vertices_b(self):
+    def n_vertices_b(self) -> int:
         return lib.sc_surface_map_n_vertices(self, _lib.SIDE_B)
 
     @property
-    def points(self):
+    def points(self) -> tuple[NDArray[np.uint32], NDArray[np.float64]]:
         """``(vertices, weights)``: for every vertex of B, three vertices of A (uint32,
         ``(n_vertices_b, 3)``) and their weights (float64, summing to 1, heaviest first)."""
         n = self.n_vertices_b
@@ -671,7 +781,9 @@ class SurfaceMap(_Handle):
         ))
         return vertices, weights
 
-    def transfer(self, values, mode="interpolate", max_influences=0):
+    def transfer(
+        self, values: ArrayLike, mode: TransferMode = "interpolate", max_influences: int = 0
+    ) -> NDArray[np.float64]:
         """``values`` on A's vertices (``(n_vertices_a,)`` or ``(n_vertices_a, channels)``)
         carried to B's vertices, same dimensionality, float64. ``mode``: ``"interpolate"``
         (continuous data), ``"nearest"`` (labels, ids) or ``"weights"`` (skin weights:
@@ -691,7 +803,9 @@ class SurfaceMap(_Handle):
         ))
         return out
 
-    def transfer_corners(self, a, faces_a, corner_values, faces_b):
+    def transfer_corners(
+        self, a: Shape, faces_a: ArrayLike, corner_values: ArrayLike, faces_b: ArrayLike
+    ) -> NDArray[np.float64]:
         """Per-corner values of A's triangles ``faces_a`` (``(n_a_triangles, 3)`` vertex
         indices of shape ``a``, the triangles it was made from) carried to the corners of
         B's triangles ``faces_b``, seams kept (texture coordinates: a UV island of A stays
@@ -714,11 +828,13 @@ class SurfaceMap(_Handle):
         ))
         return out
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"<shapecorr.SurfaceMap {self.n_vertices_b} vertices of B -> surface of A>"
 
 
-def surface_map(a, b, pointwise, progress=None):
+def surface_map(
+    a: Shape, b: Shape, pointwise: PointwiseMap, progress: ProgressCallback | None = None
+) -> SurfaceMap:
     """Where every vertex of B lands on A's surface, from ``pointwise`` (the
     :class:`PointwiseMap` of ``a`` and ``b``): the vertex map smoothed over B's neighbours
     and projected onto A's triangles. Carry data with :meth:`SurfaceMap.transfer`.

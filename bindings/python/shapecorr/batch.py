@@ -19,6 +19,8 @@ per pair, appended as each finishes. Running again resumes (recorded pairs are s
 a lost worker's tasks are rerun by Dask and written once.
 """
 
+from __future__ import annotations
+
 import ctypes
 import json
 import os
@@ -26,21 +28,34 @@ import sys
 import threading
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from . import _Params, _check, _lib
+from . import OptionValue, _Params, _check, _lib
 from ._lib import lib
 
 __all__ = ["match_pairs", "summary", "matrix", "write_matrix", "consistent_labels", "read_map"]
 
 SHAPE_SUFFIXES = (".ply", ".off", ".obj")
 
+#: A folder or file path.
+FilePath = Union[str, "os.PathLike[str]"]
+#: Files and folders of shapes, or a mapping of name -> file.
+Shapes = Union[FilePath, Iterable[FilePath], Mapping[str, FilePath]]
+#: ``"all"``, ``"one-to-many:NAME"``, a pair file, or ``(name_a, name_b)`` pairs.
+Pairs = Union[FilePath, Iterable[Tuple[str, str]]]
+#: A pair's record (a line of ``pairs.jsonl``) or a row of :func:`summary`.
+Record = dict[str, Any]
+#: ``truth(a, b)``: corresponding vertex arrays ``(vertices_a, vertices_b)``, or None.
+Truth = Callable[[str, str], Optional[Tuple[ArrayLike, ArrayLike]]]
+
 
 class _Batch:
     """One ``sc_batch`` per process and settings (kept for the process's life)."""
 
-    _kept = {}
+    _kept: dict[str, _Batch] = {}
     _lock = threading.Lock()
 
     @classmethod
@@ -121,13 +136,15 @@ def _set_up_dask_worker():
             pass
 
 
-def prepare_task(settings, name, path):
+def prepare_task(settings: dict[str, Any], name: str, path: str) -> Record:
     """The per-shape job (a Dask task): the shape's record of ``shapes.jsonl``."""
     _set_up_dask_worker()
     return _Batch.of(settings).prepare(name, path)
 
 
-def match_task(settings, a, b, out, *shape_records):
+def match_task(
+    settings: dict[str, Any], a: tuple[str, str], b: tuple[str, str], out: str, *shape_records: Record
+) -> Record:
     """The per-pair job (a Dask task, after its shapes' ``prepare_task``): the pair's record
     of ``pairs.jsonl``."""
     _set_up_dask_worker()
@@ -226,20 +243,20 @@ class _Log:
 
 
 def match_pairs(
-    shapes,
-    out,
-    pairs="all",
-    client=None,
+    shapes: Shapes,
+    out: FilePath,
+    pairs: Pairs = "all",
+    client: Any = None,
     *,
-    maps=False,
-    points=False,
-    repair=True,
-    cache=None,
-    workers=None,
-    retry_failed=False,
-    progress=None,
-    **options,
-):
+    maps: bool = False,
+    points: bool = False,
+    repair: bool = True,
+    cache: FilePath | None = None,
+    workers: int | None = None,
+    retry_failed: bool = False,
+    progress: Callable[[int, int, Record], object] | None = None,
+    **options: OptionValue,
+) -> Path:
     """Matches the ``pairs`` of ``shapes`` and writes a record per pair to
     ``out/pairs.jsonl`` (and ``out/shapes.jsonl``, ``out/maps/`` with ``maps=True``);
     returns the log's path.
@@ -351,7 +368,7 @@ def _records(out):
     return list(records.values())
 
 
-def summary(out, truth=None):
+def summary(out: FilePath, truth: Truth | None = None) -> list[Record]:
     """A row per pair of the batch in ``out``: ``a``, ``b``, ``ok``, ``error``, ``k``,
     ``regions_a``, ``regions_b`` (counts), ``matches`` (one-to-one), ``confidence``,
     ``doubtful``, ``seconds`` and, with ``truth``, ``accuracy``: ``truth(a, b)`` returns
@@ -384,7 +401,9 @@ def summary(out, truth=None):
     return rows
 
 
-def matrix(out, score="confidence", truth=None):
+def matrix(
+    out: FilePath, score: str = "confidence", truth: Truth | None = None
+) -> tuple[list[str], NDArray[np.float64]]:
     """``(names, m)``: the n x n matrix of ``score`` (a numeric column of :func:`summary`),
     ``m[i, j]`` for the pair (A = names[i], B = names[j]); NaN where there is no pair or no
     value. Names in first-seen order."""
@@ -399,7 +418,13 @@ def matrix(out, score="confidence", truth=None):
     return names, m
 
 
-def write_matrix(out, score="confidence", csv_path=None, png_path=None, truth=None):
+def write_matrix(
+    out: FilePath,
+    score: str = "confidence",
+    csv_path: FilePath | None = None,
+    png_path: FilePath | None = None,
+    truth: Truth | None = None,
+) -> tuple[list[str], NDArray[np.float64]]:
     """Writes :func:`matrix` as CSV (a header row of names; empty cells where there is no
     value) and, when ``png_path`` is given, as a heat map (needs matplotlib:
     ``pip install shapecorr[plot]``). Returns ``(names, m)``."""
@@ -434,7 +459,7 @@ def write_matrix(out, score="confidence", csv_path=None, png_path=None, truth=No
     return names, m
 
 
-def consistent_labels(out, template=None):
+def consistent_labels(out: FilePath, template: str | None = None) -> dict[str, NDArray[np.int64]]:
     """For a one-to-many run: every shape's regions labelled by the template's regions.
     Returns ``{name: labels}`` with one int per vertex: the template region its region is
     matched to one-to-one, -1 where it is unmatched; the template's own labels as they are.
@@ -445,7 +470,7 @@ def consistent_labels(out, template=None):
         if len(templates) != 1:
             raise ValueError(f"the run has {len(templates)} shapes as A; name the template")
         template = templates.pop()
-    labels = {}
+    labels: dict[str, NDArray[np.int64]] = {}
     for r in records:
         if r["a"] != template:
             continue
@@ -459,7 +484,7 @@ def consistent_labels(out, template=None):
     return labels
 
 
-def read_map(out, a, b):
+def read_map(out: FilePath, a: str, b: str) -> NDArray[np.uint32]:
     """The map of pair (``a``, ``b``) of a ``maps=True`` run: a vertex of A for every
     vertex of B (numpy uint32)."""
     for r in _records(out):

@@ -1,5 +1,7 @@
 //! Issue 19 on the command line: odd file names, special files, extreme option values and
 //! bad shapes in a pair end with a clear one-line error (or work), never a panic or a hang.
+//! Unix only: it names files with non-UTF-8 bytes and links to /dev/zero.
+#![cfg(unix)]
 
 use std::ffi::OsString;
 use std::os::unix::ffi::OsStringExt;
