@@ -63,7 +63,7 @@ pub fn region_accuracy(
 /// [`score`] of a computed correspondence (its regions and both kinds of matches), with the
 /// vertex masses of A and B.
 pub fn score_correspondence(
-    result: &crate::correspondence::Correspondence,
+    result: &crate::pipeline::Correspondence,
     mass_a: &[f64],
     mass_b: &[f64],
     ground_truth: &[(u32, u32)],

@@ -47,30 +47,29 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![warn(missing_docs)]
 
-pub mod budget;
 pub mod collection;
 pub mod colors;
-pub mod correspondence;
 pub mod error;
 pub mod evaluation;
 pub mod ffi;
 pub mod geodesic;
 pub mod maps;
-pub mod multiresolution;
 pub mod options;
+pub mod pipeline;
 pub mod progress;
 pub mod regions;
 pub mod shape;
 pub mod spectral;
 pub mod synth;
+pub mod system;
 pub mod transfer;
 
-pub use correspondence::{Correspondence, Params, Symmetry};
 pub use error::{Error, Result};
-pub use maps::pointwise::{PointwiseCorrespondence, PointwiseParams};
+pub use maps::pointwise::PointwiseParams;
+pub use pipeline::{Correspondence, Params, PointwiseCorrespondence, Symmetry};
 pub use progress::{NoProgress, Progress, Stage};
 pub use shape::{ReadAs, Repairs, Shape, ShapeKind, Warning};
-pub use spectral::eigen::{EigenParams, Eigenbasis};
+pub use spectral::eigen::{EigenParams, Eigenbasis, ShapeBasis};
 
 /// The hidden last field of every params struct (faer's pattern): callers outside the crate
 /// cannot name every field, so they write `Params { k_max: 8, ..Default::default() }` and a

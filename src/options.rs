@@ -13,9 +13,9 @@
 //! read a value with [`parse_option_value`], which also knows the choices' names
 //! (`p2p_refinement = icp`).
 
-use crate::correspondence::Params;
 use crate::maps::fmap::ZoomOutParams;
 use crate::maps::pointwise::{PointwiseParams, Refinement, RegionConstraints};
+use crate::pipeline::Params;
 use crate::{Error, Result};
 
 /// The type of an option's value.

@@ -49,6 +49,21 @@ impl<F: FnMut(Stage, f32) -> bool> Progress for F {
     }
 }
 
+/// Reports the work of `inner` as `stage` (a stage that runs another stage's operation,
+/// such as the one-to-one step verifying its answer with pointwise maps).
+pub(crate) struct AsStage<'a> {
+    /// The caller's progress.
+    pub(crate) inner: &'a mut dyn Progress,
+    /// The stage every report is made as.
+    pub(crate) stage: Stage,
+}
+
+impl Progress for AsStage<'_> {
+    fn report(&mut self, _stage: Stage, fraction: f32) -> bool {
+        self.inner.report(self.stage, fraction)
+    }
+}
+
 /// Reports and turns a cancel request into [`crate::Error::Cancelled`].
 pub(crate) fn check(progress: &mut dyn Progress, stage: Stage, fraction: f32) -> crate::Result<()> {
     if progress.report(stage, fraction.clamp(0.0, 1.0)) {
@@ -60,15 +75,16 @@ pub(crate) fn check(progress: &mut dyn Progress, stage: Stage, fraction: f32) ->
 
 /// A cancel flag shared with work running away from the caller's thread: the work polls
 /// [`Cancel::check`] in its loops and may publish how far it is with [`Cancel::set_fraction`].
+/// `Cancel::default()` is never set: pass it to run an operation to its end.
 #[derive(Debug, Default)]
-pub(crate) struct Cancel {
+pub struct Cancel {
     stop: std::sync::atomic::AtomicBool,
     fraction: std::sync::atomic::AtomicU32,
 }
 
 impl Cancel {
     /// [`crate::Error::Cancelled`] once the caller asked to stop.
-    pub(crate) fn check(&self) -> crate::Result<()> {
+    pub fn check(&self) -> crate::Result<()> {
         if self.stop.load(std::sync::atomic::Ordering::Relaxed) {
             Err(crate::Error::Cancelled)
         } else {
@@ -77,7 +93,7 @@ impl Cancel {
     }
 
     /// Publishes the fraction done (0 to 1) for the next report.
-    pub(crate) fn set_fraction(&self, fraction: f32) {
+    pub fn set_fraction(&self, fraction: f32) {
         self.fraction
             .store(fraction.to_bits(), std::sync::atomic::Ordering::Relaxed);
     }

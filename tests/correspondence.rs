@@ -1,8 +1,9 @@
 //! The whole region-correspondence pipeline on generated figures with known ground truth.
 
-use shapecorr::correspondence::{Correspondence, Params, Symmetry};
 use shapecorr::evaluation::{score_correspondence, RegionScores};
+use shapecorr::pipeline::{Correspondence, Params, Symmetry};
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
+use shapecorr::ShapeBasis;
 use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, Stage};
 
 fn humanoid(pose: usize, vertices: usize, proportions: Proportions) -> FigureMesh {
@@ -24,10 +25,15 @@ fn run(
     mirror_a: &[u32],
 ) -> (Correspondence, RegionScores) {
     let params = Params::default();
-    let basis_a = Eigenbasis::compute(a, &params.eigen).unwrap();
-    let basis_b = Eigenbasis::compute(b, &params.eigen).unwrap();
-    let result =
-        Correspondence::from_bases(a, &basis_a, b, &basis_b, &params, &mut NoProgress).unwrap();
+    let basis_a = Eigenbasis::compute(a, &params.eigen, &mut NoProgress).unwrap();
+    let basis_b = Eigenbasis::compute(b, &params.eigen, &mut NoProgress).unwrap();
+    let result = Correspondence::from_bases(
+        ShapeBasis::new(a, &basis_a),
+        ShapeBasis::new(b, &basis_b),
+        &params,
+        &mut NoProgress,
+    )
+    .unwrap();
     let flipped: Vec<(u32, u32)> = truth
         .iter()
         .map(|&(x, y)| (mirror_a[x as usize], y))

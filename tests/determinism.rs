@@ -58,7 +58,7 @@ fn eigenbasis_and_hks_are_bit_identical_for_one_and_two_threads() {
     params.eigen.n_eigenpairs = 100; // the pointwise map's basis
     let run = |threads| {
         in_pool(threads, || {
-            let basis = Eigenbasis::compute(&shape, &params.eigen).unwrap();
+            let basis = Eigenbasis::compute(&shape, &params.eigen, &mut NoProgress).unwrap();
             let h = hks(&basis, &HksParams::default()).unwrap();
             let vectors = bits((0..basis.vectors.ncols()).flat_map(|j| {
                 let col: Vec<f64> = (0..basis.vectors.nrows())

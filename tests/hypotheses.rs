@@ -3,11 +3,12 @@
 //! answer never becomes a mixed map, hard pairs keep their parts, both directions agree,
 //! and every verified answer carries a confidence.
 
-use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
 use shapecorr::geodesic::HeatGeodesics;
 use shapecorr::maps::pointwise::{PointwiseMap, PointwiseParams};
+use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::synth::{self, FigureKind, FigureMesh, Proportions};
+use shapecorr::ShapeBasis;
 use shapecorr::{EigenParams, Eigenbasis, NoProgress, Shape};
 
 fn meshes(
@@ -30,19 +31,20 @@ fn basis(shape: &Shape) -> Eigenbasis {
             n_eigenpairs: PointwiseParams::default().n_eigenpairs,
             ..Default::default()
         },
+        &mut NoProgress,
     )
     .unwrap()
 }
 
-/// The pipeline's regions and map ([`shapecorr::maps::pointwise::regions_and_map`]).
+/// The pipeline's regions and map ([`shapecorr::pipeline::pointwise::regions_and_map`]).
 fn regions_and_map(
     (a, basis_a): (&Shape, &Eigenbasis),
     (b, basis_b): (&Shape, &Eigenbasis),
     params: &Params,
 ) -> (Correspondence, PointwiseMap) {
-    shapecorr::maps::pointwise::regions_and_map(
-        (a, basis_a),
-        (b, basis_b),
+    shapecorr::pipeline::pointwise::regions_and_map(
+        ShapeBasis::new(a, basis_a),
+        ShapeBasis::new(b, basis_b),
         params,
         &PointwiseParams::default(),
         &mut NoProgress,
@@ -57,7 +59,14 @@ fn map_of(
     bb: &Eigenbasis,
     r: &Correspondence,
 ) -> PointwiseMap {
-    PointwiseMap::from_bases(a, ba, b, bb, Some(r), &PointwiseParams::default()).unwrap()
+    PointwiseMap::from_bases(
+        ShapeBasis::new(a, ba),
+        ShapeBasis::new(b, bb),
+        Some(r).map(|r| r.matches_view()),
+        &PointwiseParams::default(),
+        &mut NoProgress,
+    )
+    .unwrap()
 }
 
 /// Mean geodesic error (unit-area A) of `p2p_ba` against the truth `(truth(v), v)` on every

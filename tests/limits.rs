@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use shapecorr::options::{OptionType, OptionValue, Options, OPTIONS};
 use shapecorr::synth::{self, FigureKind, FigureSpec};
+use shapecorr::NoProgress;
 use shapecorr::{Error, PointwiseCorrespondence, Shape, Stage};
 
 fn humanoid(pose: usize, vertices: usize) -> Shape {
@@ -157,7 +158,8 @@ fn a_shape_above_max_vertices_is_refused_before_any_work() {
         .set_option("max_vertices", OptionValue::Int(500))
         .unwrap();
     let started = Instant::now();
-    let err = shapecorr::Eigenbasis::compute(&a, &options.params.eigen).unwrap_err();
+    let err =
+        shapecorr::Eigenbasis::compute(&a, &options.params.eigen, &mut NoProgress).unwrap_err();
     assert!(
         matches!(
             err,

@@ -1,8 +1,8 @@
 //! Issue 20: dense shapes run on proxies; the regions and the map come back to every input
 //! vertex, clean and as accurate as at full resolution.
 
-use shapecorr::correspondence::{Correspondence, Params};
-use shapecorr::multiresolution::Multiresolution;
+use shapecorr::pipeline::multiresolution::Multiresolution;
+use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::shape::proxy::Proxy;
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec};
 use shapecorr::{Error, NoProgress, PointwiseCorrespondence, PointwiseParams, Shape, Stage};

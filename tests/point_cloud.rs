@@ -3,6 +3,7 @@
 mod common;
 
 use shapecorr::synth::{self, FigureKind, FigureSpec};
+use shapecorr::NoProgress;
 use shapecorr::{EigenParams, Eigenbasis, Shape};
 
 fn first_eigenvalues(shape: &Shape, k: usize) -> Vec<f64> {
@@ -10,7 +11,9 @@ fn first_eigenvalues(shape: &Shape, k: usize) -> Vec<f64> {
         n_eigenpairs: k,
         ..Default::default()
     };
-    Eigenbasis::compute(shape, &params).unwrap().values
+    Eigenbasis::compute(shape, &params, &mut NoProgress)
+        .unwrap()
+        .values
 }
 
 fn assert_spectra_close(mesh: &Shape, cloud: &Shape, k: usize, tolerance: f64) {

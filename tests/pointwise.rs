@@ -6,14 +6,15 @@
 mod common;
 
 use faer::Mat;
-use shapecorr::correspondence::Params;
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
 use shapecorr::geodesic::HeatGeodesics;
 use shapecorr::maps::fmap::{fmap_to_p2p, nearest_rows, p2p_to_fmap, zoomout, ZoomOutParams};
-use shapecorr::maps::pointwise::{
-    PointwiseCorrespondence, PointwiseMap, PointwiseParams, Refinement, RegionConstraints,
-};
+use shapecorr::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement, RegionConstraints};
+use shapecorr::pipeline::Params;
+use shapecorr::progress::Cancel;
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec, Proportions};
+use shapecorr::PointwiseCorrespondence;
+use shapecorr::ShapeBasis;
 use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, Stage, Warning};
 
 fn humanoid(pose: usize, vertices: usize) -> FigureMesh {
@@ -33,6 +34,7 @@ fn basis(shape: &Shape, k: usize) -> Eigenbasis {
             n_eigenpairs: k,
             ..Default::default()
         },
+        &mut NoProgress,
     )
     .unwrap()
 }
@@ -72,7 +74,13 @@ fn identity_round_trips_between_pointwise_and_functional_maps() {
         "C of the identity map differs from I by {worst}"
     );
     // Functional map -> vertex map: the identity C gives back every vertex.
-    let p2p = fmap_to_p2p(Mat::<f64>::identity(30, 30).as_ref(), phi, phi);
+    let p2p = fmap_to_p2p(
+        Mat::<f64>::identity(30, 30).as_ref(),
+        phi,
+        phi,
+        &Cancel::default(),
+    )
+    .unwrap();
     let wrong = p2p
         .iter()
         .enumerate()
@@ -100,7 +108,7 @@ fn nearest_rows_equals_brute_force_with_lowest_index_on_ties() {
     for j in 0..17 {
         target[(600, j)] = target[(5, j)];
     }
-    let fast = nearest_rows(target.as_ref(), query.as_ref());
+    let fast = nearest_rows(target.as_ref(), query.as_ref(), &Cancel::default()).unwrap();
     for (q, &found) in fast.iter().enumerate() {
         let dist = |t: usize| {
             (0..17)
@@ -116,7 +124,12 @@ fn nearest_rows_equals_brute_force_with_lowest_index_on_ties() {
     }
     assert_eq!(fast[0], 5);
     // Without columns every target is at distance 0: the lowest index wins.
-    let empty = nearest_rows(target.subcols(0, 0), query.subcols(0, 0));
+    let empty = nearest_rows(
+        target.subcols(0, 0),
+        query.subcols(0, 0),
+        &Cancel::default(),
+    )
+    .unwrap();
     assert!(empty.len() == query.nrows() && empty.iter().all(|&t| t == 0));
 }
 
@@ -134,15 +147,20 @@ fn zoomout_repairs_a_perturbed_identity_map() {
             0.05 * (((i * 7 + j * 3) % 5) as f64 - 2.0)
         }
     });
-    let coarse = fmap_to_p2p(start.as_ref(), phi, phi);
+    let coarse = fmap_to_p2p(start.as_ref(), phi, phi, &Cancel::default()).unwrap();
     let params = ZoomOutParams {
         k_end: 60,
         step: 2,
         sample_size: 0,
         ..Default::default()
     };
-    let (c, refined) =
-        zoomout(start.as_ref(), phi, &basis.mass, phi, &basis.mass, &params).unwrap();
+    let (c, refined) = zoomout(
+        start.as_ref(),
+        ((phi, &basis.mass), (phi, &basis.mass)),
+        &params,
+        &Cancel::default(),
+    )
+    .unwrap();
     assert_eq!((c.nrows(), c.ncols()), (60, 60));
     let heat = HeatGeodesics::new(&a).unwrap();
     let truth: Vec<(u32, u32)> = (0..a.n_vertices() as u32)
@@ -215,11 +233,15 @@ fn two_poses_are_mapped_accurately_and_refinement_helps() {
     let pointwise = PointwiseParams::default();
     let basis_a = basis(&a, 100);
     let basis_b = basis(&b, 100);
-    let regions = shapecorr::correspondence::Correspondence::from_bases(
-        &a,
-        &shapecorr::maps::pointwise::truncated(&basis_a, params.eigen.n_eigenpairs),
-        &b,
-        &shapecorr::maps::pointwise::truncated(&basis_b, params.eigen.n_eigenpairs),
+    let regions = shapecorr::pipeline::Correspondence::from_bases(
+        ShapeBasis::new(
+            &a,
+            &shapecorr::pipeline::pointwise::truncated(&basis_a, params.eigen.n_eigenpairs),
+        ),
+        ShapeBasis::new(
+            &b,
+            &shapecorr::pipeline::pointwise::truncated(&basis_b, params.eigen.n_eigenpairs),
+        ),
         &params,
         &mut NoProgress,
     )
@@ -240,9 +262,15 @@ fn two_poses_are_mapped_accurately_and_refinement_helps() {
     let maps: Vec<Vec<u32>> = variants
         .iter()
         .map(|p| {
-            PointwiseMap::from_bases(&a, &basis_a, &b, &basis_b, Some(&regions), p)
-                .unwrap()
-                .p2p_ba
+            PointwiseMap::from_bases(
+                ShapeBasis::new(&a, &basis_a),
+                ShapeBasis::new(&b, &basis_b),
+                Some(regions.matches_view()),
+                p,
+                &mut NoProgress,
+            )
+            .unwrap()
+            .p2p_ba
         })
         .collect();
     let heat = HeatGeodesics::new(&a).unwrap();
@@ -330,7 +358,14 @@ fn bad_parameters_and_missing_regions_are_clear_errors() {
         ..Default::default()
     };
     // Region constraints without a region correspondence.
-    let err = PointwiseMap::from_bases(&a, &basis, &a, &basis, None, &p).unwrap_err();
+    let err = PointwiseMap::from_bases(
+        ShapeBasis::new(&a, &basis),
+        ShapeBasis::new(&a, &basis),
+        None,
+        &p,
+        &mut NoProgress,
+    )
+    .unwrap_err();
     assert!(
         matches!(
             err,
@@ -565,10 +600,9 @@ fn the_commuting_solver_reaches_the_minimum_of_its_energy() {
     let c = solve_fmap_commuting(
         coef_a.as_ref(),
         coef_b.as_ref(),
-        &values_a,
-        &values_b,
-        1.0,
+        (&values_a, &values_b, 1.0),
         &terms,
+        &Cancel::default(),
     )
     .unwrap();
     let energy =
@@ -599,10 +633,9 @@ fn the_commuting_solver_reaches_the_minimum_of_its_energy() {
     let same = solve_fmap_commuting(
         coef_a.as_ref(),
         coef_b.as_ref(),
-        &values_a,
-        &values_b,
-        1.0,
+        (&values_a, &values_b, 1.0),
         &zero,
+        &Cancel::default(),
     )
     .unwrap();
     assert_eq!(plain, same);
@@ -617,10 +650,9 @@ fn the_commuting_solver_reaches_the_minimum_of_its_energy() {
         solve_fmap_commuting(
             coef_a.as_ref(),
             coef_b.as_ref(),
-            &values_a,
-            &values_b,
-            1.0,
-            &wrong
+            (&values_a, &values_b, 1.0),
+            &wrong,
+            &Cancel::default()
         ),
         Err(Error::InvalidParameter { .. })
     ));

@@ -4,12 +4,13 @@
 //! repaired (with its warning) to within 0.02 of the clean pair's one-to-one region
 //! accuracy and 1.5x its map error, and `Repairs::none()` keeps the input as it is.
 
-use shapecorr::correspondence::Params;
 use shapecorr::evaluation::{pointwise_errors, region_accuracy, ErrorSummary};
 use shapecorr::geodesic::HeatGeodesics;
-use shapecorr::maps::pointwise::{PointwiseCorrespondence, PointwiseParams};
+use shapecorr::maps::pointwise::PointwiseParams;
+use shapecorr::pipeline::Params;
 use shapecorr::shape::{Repairs, Warning};
 use shapecorr::synth::{self, FigureKind, FigureMesh, Proportions};
+use shapecorr::PointwiseCorrespondence;
 use shapecorr::{NoProgress, Shape};
 
 /// A corrupted source shape and, for each of its vertices, the clean vertex it stands for
@@ -423,7 +424,8 @@ fn an_unrepaired_soup_fails_with_a_hint() {
         .map(|t| vec![3 * t, 3 * t + 1, 3 * t + 2])
         .collect();
     let soup = Shape::mesh_with(vertices, &polygons, &Repairs::none()).unwrap();
-    match shapecorr::Eigenbasis::compute(&soup, &shapecorr::EigenParams::default()) {
+    match shapecorr::Eigenbasis::compute(&soup, &shapecorr::EigenParams::default(), &mut NoProgress)
+    {
         Ok(basis) => panic!("an unwelded soup solved: {:?}", &basis.values[..3]),
         Err(e) => {
             let text = e.to_string();

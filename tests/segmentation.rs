@@ -13,6 +13,7 @@ use faer::Mat;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use shapecorr::regions::graph::ShapeGraph;
+use shapecorr::regions::segmentation::Described;
 use shapecorr::regions::segmentation::{
     joint_kmeans, joint_kmeans_with, rank_align, segment_pair, shape_graph, shape_graph_with,
     GraphParams, JointClustering, KMeansMetric, KMeansParams, KTieBreak, RegionExpansion,
@@ -20,6 +21,7 @@ use shapecorr::regions::segmentation::{
 };
 use shapecorr::spectral::descriptors::{hks, HksParams};
 use shapecorr::synth::{figure, figure_poses, FigureKind, FigureSpec, Proportions};
+use shapecorr::NoProgress;
 use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Shape};
 
@@ -77,7 +79,7 @@ struct Prepared {
 }
 
 fn prepare(shape: Shape) -> Prepared {
-    let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
+    let basis = Eigenbasis::compute(&shape, &EigenParams::default(), &mut NoProgress).unwrap();
     let hks = hks(&basis, &HksParams::default()).unwrap();
     Prepared {
         shape,
@@ -648,13 +650,18 @@ fn two_poses_give_consistent_segmentations_independent_of_vertex_order() {
     let (a, b) = hks_pair(4000);
     let params = SegmentationParams::default();
     let result = segment_pair(
-        &a.shape,
-        &a.mass,
-        a.hks.as_ref(),
-        &b.shape,
-        &b.mass,
-        b.hks.as_ref(),
+        Described {
+            shape: &a.shape,
+            mass: &a.mass,
+            descriptors: a.hks.as_ref(),
+        },
+        Described {
+            shape: &b.shape,
+            mass: &b.mass,
+            descriptors: b.hks.as_ref(),
+        },
         &params,
+        &mut NoProgress,
     )
     .unwrap();
     assert!((params.k_min..=params.k_max).contains(&result.k));
@@ -680,13 +687,18 @@ fn two_poses_give_consistent_segmentations_independent_of_vertex_order() {
     let mass_p: Vec<f64> = p.iter().map(|&i| a.mass[i]).collect();
     let hks_p = Mat::from_fn(n, a.hks.ncols(), |i, j| a.hks[(p[i], j)]);
     let again = segment_pair(
-        &shape_p,
-        &mass_p,
-        hks_p.as_ref(),
-        &b.shape,
-        &b.mass,
-        b.hks.as_ref(),
+        Described {
+            shape: &shape_p,
+            mass: &mass_p,
+            descriptors: hks_p.as_ref(),
+        },
+        Described {
+            shape: &b.shape,
+            mass: &b.mass,
+            descriptors: b.hks.as_ref(),
+        },
         &params,
+        &mut NoProgress,
     )
     .unwrap();
     assert_eq!(again.k, result.k);
@@ -728,13 +740,18 @@ fn segment_pair_falls_back_when_no_k_is_acceptable() {
         ..Default::default()
     };
     let result = segment_pair(
-        &two.shape,
-        &two.mass,
-        two.hks.as_ref(),
-        &two.shape,
-        &two.mass,
-        two.hks.as_ref(),
+        Described {
+            shape: &two.shape,
+            mass: &two.mass,
+            descriptors: two.hks.as_ref(),
+        },
+        Described {
+            shape: &two.shape,
+            mass: &two.mass,
+            descriptors: two.hks.as_ref(),
+        },
         &params,
+        &mut NoProgress,
     )
     .unwrap();
     assert!(result
@@ -760,13 +777,18 @@ fn segment_pair_falls_back_when_no_k_is_acceptable() {
         ..Default::default()
     };
     let result = segment_pair(
-        &one.shape,
-        &one.mass,
-        one.hks.as_ref(),
-        &one.shape,
-        &one.mass,
-        one.hks.as_ref(),
+        Described {
+            shape: &one.shape,
+            mass: &one.mass,
+            descriptors: one.hks.as_ref(),
+        },
+        Described {
+            shape: &one.shape,
+            mass: &one.mass,
+            descriptors: one.hks.as_ref(),
+        },
         &tight,
+        &mut NoProgress,
     )
     .unwrap();
     assert!(result.candidates.iter().all(|c| !c.acceptable));
@@ -780,13 +802,18 @@ fn segment_pair_rejects_bad_inputs() {
     let h = prepare(figure_shape(FigureKind::Star { limbs: 3 }, 0, 800));
     let run = |params: &SegmentationParams, mass: &[f64], desc: &Mat<f64>| {
         segment_pair(
-            &h.shape,
-            &h.mass,
-            h.hks.as_ref(),
-            &h.shape,
-            mass,
-            desc.as_ref(),
+            Described {
+                shape: &h.shape,
+                mass: &h.mass,
+                descriptors: h.hks.as_ref(),
+            },
+            Described {
+                shape: &h.shape,
+                mass,
+                descriptors: desc.as_ref(),
+            },
             params,
+            &mut NoProgress,
         )
     };
     let ok = SegmentationParams::default();
@@ -871,13 +898,18 @@ fn print_variants<S: std::fmt::Display>(
             let (a, b) = (&shapes[&ia], &shapes[&ib]);
             let t = Instant::now();
             let result = segment_pair(
-                &a.shape,
-                &a.mass,
-                a.hks.as_ref(),
-                &b.shape,
-                &b.mass,
-                b.hks.as_ref(),
+                Described {
+                    shape: &a.shape,
+                    mass: &a.mass,
+                    descriptors: a.hks.as_ref(),
+                },
+                Described {
+                    shape: &b.shape,
+                    mass: &b.mass,
+                    descriptors: b.hks.as_ref(),
+                },
                 params,
+                &mut NoProgress,
             )
             .unwrap();
             let seconds = t.elapsed().as_secs_f64();
@@ -1079,13 +1111,18 @@ fn faust_metric_comparison() {
         for &(ia, ib) in &pairs {
             let (a, b) = (&shapes[&ia], &shapes[&ib]);
             let result = segment_pair(
-                &a.shape,
-                &a.mass,
-                a.hks.as_ref(),
-                &b.shape,
-                &b.mass,
-                b.hks.as_ref(),
+                Described {
+                    shape: &a.shape,
+                    mass: &a.mass,
+                    descriptors: a.hks.as_ref(),
+                },
+                Described {
+                    shape: &b.shape,
+                    mass: &b.mass,
+                    descriptors: b.hks.as_ref(),
+                },
                 &params,
+                &mut NoProgress,
             )
             .unwrap();
             let identity: Vec<usize> = (0..a.mass.len()).collect();
@@ -1153,13 +1190,18 @@ fn large_generated_pair_timing() {
     }
     let t = Instant::now();
     let result = segment_pair(
-        &a.shape,
-        &a.mass,
-        a.hks.as_ref(),
-        &b.shape,
-        &b.mass,
-        b.hks.as_ref(),
+        Described {
+            shape: &a.shape,
+            mass: &a.mass,
+            descriptors: a.hks.as_ref(),
+        },
+        Described {
+            shape: &b.shape,
+            mass: &b.mass,
+            descriptors: b.hks.as_ref(),
+        },
         &SegmentationParams::default(),
+        &mut NoProgress,
     )
     .unwrap();
     eprintln!(

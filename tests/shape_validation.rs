@@ -3,6 +3,7 @@
 mod common;
 
 use common::icosphere;
+use shapecorr::NoProgress;
 use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Error, Shape, Warning};
 
@@ -17,6 +18,7 @@ fn small_basis(shape: &Shape) -> Eigenbasis {
             n_eigenpairs: 12,
             ..Default::default()
         },
+        &mut NoProgress,
     )
     .unwrap()
 }

@@ -139,6 +139,7 @@ fn sphere_spectrum_has_multiplicities_1_3_5_7_and_values_l_l_plus_1() {
             n_eigenpairs: 20,
             ..Default::default()
         },
+        &mut NoProgress,
     )
     .unwrap();
     // Unit-area scaling multiplies the unit sphere's l(l+1) by its area.
@@ -166,7 +167,7 @@ fn sphere_spectrum_has_multiplicities_1_3_5_7_and_values_l_l_plus_1() {
 #[test]
 fn hks_is_constant_on_the_sphere() {
     let shape = sphere(5);
-    let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
+    let basis = Eigenbasis::compute(&shape, &EigenParams::default(), &mut NoProgress).unwrap();
     let h = hks(&basis, &HksParams::default()).unwrap();
     assert_eq!((h.nrows(), h.ncols()), (shape.n_vertices(), 15));
     for t in 0..h.ncols() {
@@ -204,7 +205,7 @@ fn small_params() -> EigenParams {
 #[test]
 fn eigenvalues_and_hks_do_not_change_under_permutation_rigid_motion_and_scaling() {
     let shape = bumpy_sphere();
-    let reference = Eigenbasis::compute(&shape, &small_params()).unwrap();
+    let reference = Eigenbasis::compute(&shape, &small_params(), &mut NoProgress).unwrap();
     let reference_hks = hks(&reference, &HksParams::default()).unwrap();
 
     // Vertex permutation: new vertex i is old vertex perm[i].
@@ -238,7 +239,7 @@ fn eigenvalues_and_hks_do_not_change_under_permutation_rigid_motion_and_scaling(
         ("permuted", &permuted, perm.clone()),
         ("moved and scaled", &moved, (0..n).collect::<Vec<_>>()),
     ] {
-        let basis = Eigenbasis::compute(other, &small_params()).unwrap();
+        let basis = Eigenbasis::compute(other, &small_params(), &mut NoProgress).unwrap();
         for j in 1..basis.len() {
             let r = rel(basis.values[j], reference.values[j], 0.0);
             assert!(r < 1e-8, "{name}: eigenvalue {j} differs by {r}");
@@ -271,6 +272,7 @@ fn eigenbasis_is_identical_on_any_thread_count() {
                     threads,
                     ..small_params()
                 },
+                &mut NoProgress,
             )
             .unwrap()
         })
@@ -286,7 +288,7 @@ fn eigenbasis_is_identical_on_any_thread_count() {
 #[test]
 fn wks_rows_are_normalised_distributions_and_log_hks_is_the_log() {
     let shape = bumpy_sphere();
-    let basis = Eigenbasis::compute(&shape, &small_params()).unwrap();
+    let basis = Eigenbasis::compute(&shape, &small_params(), &mut NoProgress).unwrap();
     let w = wks(&basis, &WksParams::default()).unwrap();
     assert_eq!(w.ncols(), 100);
     // Each energy's weights sum to 1, and sum_v M_v phi_i(v)^2 = 1, so the mass-weighted
@@ -327,7 +329,7 @@ fn two_pieces_and_unreferenced_vertices_are_handled() {
     assert!(shape
         .warnings()
         .contains(&shapecorr::Warning::UnreferencedVertices { count: 3 }));
-    let basis = Eigenbasis::compute(&shape, &small_params()).unwrap();
+    let basis = Eigenbasis::compute(&shape, &small_params(), &mut NoProgress).unwrap();
     // One zero eigenvalue per piece.
     assert!(basis.values[0].abs() < 1e-8 && basis.values[1].abs() < 1e-8);
     assert!(basis.values[2] > 1.0);
@@ -351,8 +353,7 @@ fn cancelling_from_the_progress_callback_stops_the_eigensolver() {
         }
         calls < 3
     };
-    let result =
-        Eigenbasis::compute_with_progress(&shape, &EigenParams::default(), &mut cancel_after_three);
+    let result = Eigenbasis::compute(&shape, &EigenParams::default(), &mut cancel_after_three);
     assert!(
         matches!(result, Err(shapecorr::Error::Cancelled)),
         "{result:?}"
@@ -374,7 +375,7 @@ fn a_pair_of_eigenbases_is_the_two_computed_alone_and_can_be_cancelled() {
             .unwrap();
         pool.install(|| Eigenbasis::pair((&a, &b), &params, &mut NoProgress).unwrap())
     };
-    let alone = [&a, &b].map(|s| Eigenbasis::compute(s, &params).unwrap());
+    let alone = [&a, &b].map(|s| Eigenbasis::compute(s, &params, &mut NoProgress).unwrap());
     // Two threads solve the two side by side, one thread one after the other.
     for threads in [1, 2] {
         let (pair, seconds) = on(threads);

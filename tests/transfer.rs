@@ -157,7 +157,8 @@ struct Figures {
 
 fn measure(n_a: usize, n_b: usize, pose_b: usize) -> Figures {
     let p = pair(n_a, n_b, pose_b);
-    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let map =
+        SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba, &mut NoProgress).unwrap();
     let truth = true_images(&p.rig_a, &p.rig_b);
     let rest_a = &p.rig_a.rest.vertices;
     let scale = height(rest_a);
@@ -239,7 +240,8 @@ fn skin_weights_carried_to_another_pose_and_body_pose_it_as_its_own() {
 #[test]
 fn weights_mode_keeps_rows_normalised_with_at_most_the_influences_asked() {
     let p = pair(3000, 3000, 3);
-    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let map =
+        SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba, &mut NoProgress).unwrap();
     let bones = p.rig_a.n_bones;
     for limit in [1, 2, 4] {
         let out = map
@@ -262,7 +264,8 @@ fn weights_mode_keeps_rows_normalised_with_at_most_the_influences_asked() {
 #[test]
 fn nearest_mode_carries_labels_unchanged_and_interpolation_is_exact_on_linear_data() {
     let p = pair(3000, 3000, 3);
-    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let map =
+        SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba, &mut NoProgress).unwrap();
     // Labels: every value of B is one of A's.
     let labels: Vec<f64> = (0..p.shape_a.n_vertices())
         .map(|v| (v % 7) as f64)
@@ -283,7 +286,8 @@ fn nearest_mode_carries_labels_unchanged_and_interpolation_is_exact_on_linear_da
 #[test]
 fn bad_values_are_refused_with_the_vertex_named() {
     let p = pair(3000, 3000, 3);
-    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let map =
+        SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba, &mut NoProgress).unwrap();
     let n = p.shape_a.n_vertices();
     let message = |values: &[f64], channels, mode| {
         map.transfer(values, channels, mode)
@@ -297,10 +301,13 @@ fn bad_values_are_refused_with_the_vertex_named() {
     assert!(message(&values, 2, TransferMode::Interpolate).contains("vertex 3 channel 1"));
     values[7] = -0.1;
     assert!(message(&values, 2, TransferMode::Weights { max_influences: 0 }).contains("vertex 3"));
-    assert!(SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba[1..]).is_err());
+    assert!(
+        SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba[1..], &mut NoProgress)
+            .is_err()
+    );
     let mut wrong = p.p2p_ba.clone();
     wrong[0] = n as u32;
-    assert!(SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &wrong).is_err());
+    assert!(SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &wrong, &mut NoProgress).is_err());
 }
 
 /// A cylindrical unwrap about the vertical axis, per corner: u = the angle about the axis
@@ -377,7 +384,8 @@ fn smeared(uv: &[f64], truth: &[f64]) -> usize {
 #[test]
 fn texture_coordinates_keep_their_seams() {
     let p = pair(4000, 8000, 1);
-    let map = SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba).unwrap();
+    let map =
+        SurfaceMap::from_vertex_map(&p.shape_a, &p.shape_b, &p.p2p_ba, &mut NoProgress).unwrap();
     let (faces_a, faces_b) = (&p.rig_a.rest.triangles, &p.rig_b.rest.triangles);
     let uv_a = cylinder_uv(&p.rig_a.rest.vertices, faces_a);
     let truth = cylinder_uv(&p.rig_b.rest.vertices, faces_b);

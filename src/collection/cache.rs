@@ -105,7 +105,7 @@ impl BasisCache {
             }
         }
         let t = Instant::now();
-        let basis = Eigenbasis::compute(shape, params)?;
+        let basis = Eigenbasis::compute(shape, params, &mut crate::NoProgress)?;
         let seconds = t.elapsed().as_secs_f64();
         if let Some(file) = &file {
             write_basis(file, &basis, seconds)?;

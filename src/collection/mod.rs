@@ -2,15 +2,16 @@
 //!
 //! The data flow of a batch:
 //! - a shape file -> [`Batch::prepare`]: read (and repaired), its proxy when dense
-//!   ([`crate::multiresolution`]), its eigenbasis from the disk cache or computed and stored
+//!   ([`crate::pipeline::multiresolution`]), its eigenbasis from the disk cache or computed and stored
 //!   ([`BasisCache`]) -> a [`PreparedShape`] and a [`ShapeRecord`];
 //! - two prepared shapes -> [`Batch::match_pair`]: the regions (and the map) of the pair ->
 //!   a [`PairRecord`], one line of the batch log ([`ResultLog`]); a map is a binary file
 //!   beside the log. A failure is a record with the library's message, never an abort.
 //!
-//! A pair's regions and map are those [`Correspondence::compute`] (or
-//! [`PointwiseCorrespondence::compute`]) gives on the same files and options: the same
-//! proxies, the same eigenbases (bit for bit from the cache), the same pair stage.
+//! A pair's regions and map are those [`crate::Correspondence::compute`] (or
+//! [`crate::PointwiseCorrespondence::compute`]) gives on the same files and options: the
+//! same proxies, the same eigenbases (bit for bit from the cache), the same pair job
+//! ([`run_pair`]).
 //! The command line's `shapecorr batch` and the Python package's `shapecorr.batch` (locally
 //! or on a Dask cluster) both run through here.
 
@@ -27,14 +28,12 @@ use serde::{Deserialize, Serialize};
 pub use cache::{BasisCache, TimedBasis};
 pub use log::ResultLog;
 
-use crate::maps::pointwise::basis_params;
-use crate::multiresolution::{lift_map, lift_regions, working};
 use crate::options::Options;
+use crate::pipeline::multiresolution::working;
+use crate::pipeline::{run_pair, PairJob, PairShapes, ReadyShape};
 use crate::shape::proxy::Proxy;
 use crate::spectral::eigen::{EigenParams, Eigenbasis};
-use crate::{
-    Correspondence, Error, NoProgress, PointwiseCorrespondence, ReadAs, Repairs, Result, Shape,
-};
+use crate::{Error, NoProgress, ReadAs, Repairs, Result, Shape};
 
 /// How shape files are read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,10 +68,10 @@ impl Reading {
 /// What a batch computes for each pair.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Outputs {
-    /// The region correspondence ([`Correspondence::compute`]).
+    /// The region correspondence ([`crate::Correspondence::compute`]).
     Regions,
     /// The regions and the point-to-point map from B to A
-    /// ([`PointwiseCorrespondence::compute`]; its regions are those of `shapecorr p2p`).
+    /// ([`crate::PointwiseCorrespondence::compute`]; its regions are those of `shapecorr p2p`).
     RegionsAndMaps,
 }
 
@@ -101,7 +100,7 @@ pub const DEFAULT_MEMORY_BYTES: usize = 2 << 30;
 pub struct PreparedShape {
     /// The shape as read from its file.
     pub shape: Shape,
-    /// Its proxy when it is dense ([`crate::multiresolution`]).
+    /// Its proxy when it is dense ([`crate::pipeline::multiresolution`]).
     pub proxy: Option<Proxy>,
     /// The eigenbasis of the working shape (the proxy's, or the shape's).
     pub basis: Eigenbasis,
@@ -115,6 +114,15 @@ impl PreparedShape {
     /// The shape the pipeline runs on: the proxy, or the shape itself.
     pub fn working(&self) -> &Shape {
         working(&self.shape, &self.proxy)
+    }
+
+    /// The shape as the pair job takes it.
+    pub fn ready(&self) -> ReadyShape<'_> {
+        ReadyShape {
+            shape: &self.shape,
+            proxy: self.proxy.as_ref(),
+            basis: &self.basis,
+        }
     }
 
     fn bytes(&self) -> usize {
@@ -211,10 +219,14 @@ impl Batch {
     pub fn new(settings: BatchSettings) -> Result<Batch> {
         settings.options.validate()?;
         let params = &settings.options.params;
-        let eigen = match settings.outputs {
-            Outputs::Regions => params.eigen.clone(),
-            Outputs::RegionsAndMaps => basis_params(params, settings.options.pointwise()),
+        let job = PairJob {
+            params,
+            map: match settings.outputs {
+                Outputs::Regions => None,
+                Outputs::RegionsAndMaps => Some(settings.options.pointwise()),
+            },
         };
+        let eigen = job.eigen_params();
         std::fs::create_dir_all(&settings.cache_dir)
             .map_err(|e| Error::file(&settings.cache_dir, e.to_string()))?;
         Ok(Batch {
@@ -358,57 +370,26 @@ impl Batch {
         record: &mut PairRecord,
         out_dir: &Path,
     ) -> Result<()> {
-        let params = &self.settings.options.params;
-        let proxies = [a.proxy.as_ref(), b.proxy.as_ref()];
-        let (regions, map) = match self.settings.outputs {
-            Outputs::Regions => {
-                params
-                    .budget
-                    .check(&Correspondence::job(&a.shape, &b.shape, params))?;
-                let regions = params.budget.run(&mut NoProgress, |progress| {
-                    let mut regions = Correspondence::from_bases(
-                        a.working(),
-                        &a.basis,
-                        b.working(),
-                        &b.basis,
-                        params,
-                        progress,
-                    )?;
-                    lift_regions(&mut regions, proxies);
-                    Ok(regions)
-                })?;
-                (regions, None)
-            }
-            Outputs::RegionsAndMaps => {
-                let pointwise = self.settings.options.pointwise();
-                params.budget.check(&PointwiseCorrespondence::job(
-                    &a.shape, &b.shape, params, pointwise,
-                ))?;
-                params.budget.run(&mut NoProgress, |progress| {
-                    let (mut regions, mut map) = crate::maps::pointwise::regions_and_map(
-                        (a.working(), &a.basis),
-                        (b.working(), &b.basis),
-                        params,
-                        pointwise,
-                        progress,
-                    )?;
-                    lift_regions(&mut regions, proxies);
-                    map.p2p_ba = lift_map(
-                        (&a.shape, &a.proxy),
-                        (&b.shape, &b.proxy),
-                        &map.p2p_ba,
-                        progress,
-                    )?;
-                    if map.verdict.is_some() {
-                        regions.verdict = map.verdict.clone();
-                    }
-                    record
-                        .stages
-                        .insert("map".into(), map.timings.fmap + map.timings.refinement);
-                    Ok((regions, Some(map.p2p_ba)))
-                })?
-            }
+        let options = &self.settings.options;
+        let job = PairJob {
+            params: &options.params,
+            map: match self.settings.outputs {
+                Outputs::Regions => None,
+                Outputs::RegionsAndMaps => Some(options.pointwise()),
+            },
         };
+        let pair = run_pair(
+            PairShapes::Ready(a.ready(), b.ready()),
+            job,
+            &mut NoProgress,
+        )?;
+        let regions = pair.regions;
+        let map = pair.map.map(|map| {
+            record
+                .stages
+                .insert("map".into(), map.timings.fmap + map.timings.refinement);
+            map.p2p_ba
+        });
         let t = &regions.timings;
         for (stage, seconds) in [
             ("descriptors", t.descriptors),

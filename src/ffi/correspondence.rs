@@ -9,8 +9,8 @@ use super::boundary::{
 use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
-use crate::correspondence::Correspondence;
 use crate::maps::hypotheses::Verdict;
+use crate::pipeline::Correspondence;
 use crate::regions::graph::ShapeGraph;
 
 /// The result of `sc_match`. Immutable: one handle may be read from several threads at
@@ -416,8 +416,8 @@ pub unsafe extern "C" fn sc_correspondence_warning(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::correspondence::Timings;
     use crate::maps::hypotheses::{HypothesisKind, HypothesisScore, MapEnergy, DOUBTFUL_BELOW};
+    use crate::pipeline::Timings;
 
     #[test]
     fn header_threshold_matches_the_verdicts() {
@@ -465,6 +465,7 @@ mod tests {
                 ],
                 confidence,
             }),
+            estimate: None,
         })
     }
 

@@ -8,8 +8,8 @@ use std::sync::OnceLock;
 use super::boundary::{
     boundary, check_out, free_handle, give_handle, handle, input_str, Failure, FfiResult, ScStatus,
 };
-use crate::correspondence::Params;
 use crate::options::{option_info, OptionType, OptionValue, Options, OPTIONS};
+use crate::pipeline::Params;
 
 /// Every parameter of the method: the region correspondence's and (options named `p2p_*`)
 /// the pointwise map's. Setters change it; use one handle from one thread while setting,

@@ -10,7 +10,7 @@ use super::correspondence::{warning_ptr, warning_text, ScCorrespondence, SC_SIDE
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
-use crate::maps::pointwise::PointwiseCorrespondence;
+use crate::pipeline::PointwiseCorrespondence;
 
 /// The result of `sc_pointwise_map`: a vertex map from B to A, the functional map from A to
 /// B and the region correspondence it was built on. Immutable: one handle may be read from

@@ -10,7 +10,7 @@ use super::correspondence::rgba;
 use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
 use super::{CallbackProgress, ScProgressCallback};
-use crate::correspondence::Symmetry;
+use crate::pipeline::Symmetry;
 
 /// The result of `sc_symmetry_detect`. Immutable: one handle may be read from several
 /// threads at once. Free it with `sc_symmetry_free`.

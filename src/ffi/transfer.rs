@@ -68,8 +68,7 @@ pub unsafe extern "C" fn sc_surface_map_new(
             callback: progress,
             userdata,
         };
-        let map =
-            SurfaceMap::from_vertex_map_with_progress(a, b, &result.map.p2p_ba, &mut progress)?;
+        let map = SurfaceMap::from_vertex_map(a, b, &result.map.p2p_ba, &mut progress)?;
         give_handle(out_map, ScSurfaceMap { map })
     })
 }

@@ -216,23 +216,9 @@ const CG_TOLERANCE: f64 = 1e-9;
 /// `||C A - B||^2 + w_L ||C Lambda_a - Lambda_b C||^2 + sum_terms w sum_f ||C DA_f - DB_f C||^2`.
 /// The term couples the rows of C, so the normal equations are solved by conjugate
 /// gradients, preconditioned by the row-wise systems (sequential, hence deterministic).
+/// Stops with [`Error::Cancelled`] between conjugate-gradient iterations once `cancel` is
+/// set (up to [`CG_MAX_ITERATIONS`] of them with a heavy commutativity weight).
 pub fn solve_fmap_commuting(
-    coef_a: MatRef<'_, f64>,
-    coef_b: MatRef<'_, f64>,
-    values_a: &[f64],
-    values_b: &[f64],
-    laplacian_weight: f64,
-    terms: &[Commutativity<'_>],
-) -> Result<Mat<f64>> {
-    let cancel = Cancel::default();
-    let problem = (values_a, values_b, laplacian_weight);
-    solve_fmap_commuting_cancellable(coef_a, coef_b, problem, terms, &cancel)
-}
-
-/// As [`solve_fmap_commuting`], stopping with [`Error::Cancelled`] between
-/// conjugate-gradient iterations once `cancel` is set (up to [`CG_MAX_ITERATIONS`] of
-/// them with a heavy commutativity weight).
-pub(crate) fn solve_fmap_commuting_cancellable(
     coef_a: MatRef<'_, f64>,
     coef_b: MatRef<'_, f64>,
     (values_a, values_b, laplacian_weight): (&[f64], &[f64], f64),
@@ -465,14 +451,9 @@ impl RowSystems {
 /// `|q - t|^2 = |t|^2 - 2 q.t + |q|^2`, the middle term by matrix products in single
 /// precision (three times the speed of double here), then the best `RERANK` = 4 candidates
 /// re-ranked by their exact distance. Deterministic on any thread count.
-pub fn nearest_rows(target: MatRef<'_, f64>, query: MatRef<'_, f64>) -> Vec<u32> {
-    nearest_rows_cancellable(target, query, &Cancel::default()).expect("never cancelled")
-}
-
-/// As [`nearest_rows`], stopping with [`Error::Cancelled`] between blocks of
-/// [`NN_BLOCK`] queries once `cancel` is set (a block of a 50K-vertex target in 100
-/// dimensions takes a few hundredths of a second).
-pub(crate) fn nearest_rows_cancellable(
+/// Stops with [`Error::Cancelled`] between blocks of [`NN_BLOCK`] queries once `cancel` is
+/// set (a block of a 50K-vertex target in 100 dimensions takes a few hundredths of a second).
+pub fn nearest_rows(
     target: MatRef<'_, f64>,
     query: MatRef<'_, f64>,
     cancel: &Cancel,
@@ -610,16 +591,8 @@ fn offer(best: &mut [(f32, u32); RERANK], j: usize, d: f32) {
 /// The pointwise map `p2p_ba` of a functional map `fmap_ab` (`k_b x k_a`): every vertex of
 /// shape B (row of `phi_b[:, :k_b]`) goes to the vertex of shape A whose row of
 /// `phi_a[:, :k_a] C^T` is nearest.
+/// Honours `cancel` as [`nearest_rows`] does.
 pub fn fmap_to_p2p(
-    fmap_ab: MatRef<'_, f64>,
-    phi_a: MatRef<'_, f64>,
-    phi_b: MatRef<'_, f64>,
-) -> Vec<u32> {
-    fmap_to_p2p_cancellable(fmap_ab, phi_a, phi_b, &Cancel::default()).expect("never cancelled")
-}
-
-/// As [`fmap_to_p2p`], honouring `cancel` ([`nearest_rows_cancellable`]).
-pub(crate) fn fmap_to_p2p_cancellable(
     fmap_ab: MatRef<'_, f64>,
     phi_a: MatRef<'_, f64>,
     phi_b: MatRef<'_, f64>,
@@ -635,7 +608,7 @@ pub(crate) fn fmap_to_p2p_cancellable(
         1.0,
         Par::Seq,
     );
-    nearest_rows_cancellable(embedding_a.as_ref(), phi_b.subcols(0, k_b), cancel)
+    nearest_rows(embedding_a.as_ref(), phi_b.subcols(0, k_b), cancel)
 }
 
 /// The functional map `C_ab = Phi_b^T M_b Pi_ba Phi_a` (`k_b x k_a`) of a pointwise map
@@ -744,33 +717,20 @@ impl Default for ZoomOutParams {
 /// ZoomOut: starting from `fmap_ab` (`k x k`), repeatedly convert to a pointwise map and back
 /// with `k + step` eigenfunctions until `k_end`; returns the final `fmap_ab` and the
 /// full-resolution `p2p_ba`.
+/// Stops with [`Error::Cancelled`] within an iteration once `cancel` is set.
 pub fn zoomout(
-    fmap_ab: MatRef<'_, f64>,
-    phi_a: MatRef<'_, f64>,
-    mass_a: &[f64],
-    phi_b: MatRef<'_, f64>,
-    mass_b: &[f64],
-    params: &ZoomOutParams,
-) -> Result<(Mat<f64>, Vec<u32>)> {
-    let bases = ((phi_a, mass_a), (phi_b, mass_b));
-    zoomout_cancellable(fmap_ab, bases, params, &Cancel::default())
-}
-
-/// A shape's eigenbasis (one row per vertex) and its vertex masses.
-pub(crate) type BasisRef<'a> = (MatRef<'a, f64>, &'a [f64]);
-
-/// As [`zoomout`], stopping with [`Error::Cancelled`] within an iteration once `cancel`
-/// is set.
-pub(crate) fn zoomout_cancellable(
     fmap_ab: MatRef<'_, f64>,
     (a, b): (BasisRef<'_>, BasisRef<'_>),
     params: &ZoomOutParams,
     cancel: &Cancel,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
     let run = ZoomOutRun::new(fmap_ab, (a, b), params, cancel)?;
-    let p2p_ba = fmap_to_p2p_cancellable(run.fmap_ab.as_ref(), a.0, b.0, cancel)?;
+    let p2p_ba = fmap_to_p2p(run.fmap_ab.as_ref(), a.0, b.0, cancel)?;
     Ok((run.fmap_ab, p2p_ba))
 }
+
+/// A shape's eigenbasis (one row per vertex) and its vertex masses.
+pub type BasisRef<'a> = (MatRef<'a, f64>, &'a [f64]);
 
 /// ZoomOut's iterations without the final full-resolution conversion: the final functional
 /// map and its pointwise map between the samples.
@@ -789,20 +749,8 @@ pub struct SampledZoomOut {
 
 /// [`zoomout`] up to, not including, the full-resolution conversion (for comparing
 /// candidate maps before paying for it).
+/// Honours `cancel` as [`zoomout`] does.
 pub fn zoomout_on_samples(
-    fmap_ab: MatRef<'_, f64>,
-    phi_a: MatRef<'_, f64>,
-    mass_a: &[f64],
-    phi_b: MatRef<'_, f64>,
-    mass_b: &[f64],
-    params: &ZoomOutParams,
-) -> Result<SampledZoomOut> {
-    let bases = ((phi_a, mass_a), (phi_b, mass_b));
-    zoomout_on_samples_cancellable(fmap_ab, bases, params, &Cancel::default())
-}
-
-/// As [`zoomout_on_samples`], honouring `cancel`.
-pub(crate) fn zoomout_on_samples_cancellable(
     fmap_ab: MatRef<'_, f64>,
     bases: (BasisRef<'_>, BasisRef<'_>),
     params: &ZoomOutParams,
@@ -810,7 +758,7 @@ pub(crate) fn zoomout_on_samples_cancellable(
 ) -> Result<SampledZoomOut> {
     let run = ZoomOutRun::new(fmap_ab, bases, params, cancel)?;
     let (sub_a, sub_b) = (run.sub_a.as_ref(), run.sub_b.as_ref());
-    let p2p_sub = fmap_to_p2p_cancellable(run.fmap_ab.as_ref(), sub_a, sub_b, cancel)?;
+    let p2p_sub = fmap_to_p2p(run.fmap_ab.as_ref(), sub_a, sub_b, cancel)?;
     Ok(SampledZoomOut {
         p2p_ba: run.sample_a.on_vertices(&p2p_sub),
         fmap_ab: run.fmap_ab,
@@ -859,8 +807,7 @@ impl ZoomOutRun {
         while k < params.k_end {
             // Pointwise map on the samples with the current map, then the functional map one
             // step larger from it.
-            let p2p_sub =
-                fmap_to_p2p_cancellable(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref(), cancel)?;
+            let p2p_sub = fmap_to_p2p(fmap.as_ref(), sub_a.as_ref(), sub_b.as_ref(), cancel)?;
             k = (k + params.step).min(params.k_end);
             fmap = weighted_fmap(
                 &sample_a.on_vertices(&p2p_sub),
@@ -926,26 +873,8 @@ fn weighted_fmap(
 /// `iterations` rounds or until the map stops changing. Like [`zoomout`], the rounds run on
 /// seeded vertex samples of `sample_size` per shape (0 = every vertex), then one
 /// full-resolution conversion. Returns `fmap_ab` and `p2p_ba`.
+/// Honours `cancel` between rounds.
 pub fn icp_refine(
-    fmap_ab: MatRef<'_, f64>,
-    phi_a: MatRef<'_, f64>,
-    mass_a: &[f64],
-    phi_b: MatRef<'_, f64>,
-    mass_b: &[f64],
-    iterations: usize,
-    sample_size: usize,
-) -> Result<(Mat<f64>, Vec<u32>)> {
-    let bases = ((phi_a, mass_a), (phi_b, mass_b));
-    icp_refine_cancellable(
-        fmap_ab,
-        bases,
-        (iterations, sample_size),
-        &Cancel::default(),
-    )
-}
-
-/// As [`icp_refine`], honouring `cancel`.
-pub(crate) fn icp_refine_cancellable(
     fmap_ab: MatRef<'_, f64>,
     ((phi_a, mass_a), (phi_b, mass_b)): (BasisRef<'_>, BasisRef<'_>),
     (iterations, sample_size): (usize, usize),
@@ -966,9 +895,7 @@ pub(crate) fn icp_refine_cancellable(
     let sample_b = Sample::of_size(mass_b, sample_size, SAMPLE_SEED + 1);
     let (sub_a, sub_b) = (sample_a.rows(phi_a, k_a), sample_b.rows(phi_b, k_b));
     let mut fmap = fmap_ab.to_owned();
-    let convert = |fmap: &Mat<f64>, phi_a, phi_b| {
-        fmap_to_p2p_cancellable(fmap.as_ref(), phi_a, phi_b, cancel)
-    };
+    let convert = |fmap: &Mat<f64>, phi_a, phi_b| fmap_to_p2p(fmap.as_ref(), phi_a, phi_b, cancel);
     let mut p2p = convert(&fmap, sub_a.as_ref(), sub_b.as_ref())?;
     for _ in 0..iterations {
         let vertices = sample_a.on_vertices(&p2p);

@@ -13,11 +13,11 @@
 
 use rayon::prelude::*;
 
-use crate::correspondence::Correspondence;
 use crate::geodesic::EdgeGraph;
 use crate::maps::fmap::SampledZoomOut;
+use crate::regions::RegionMatches;
 use crate::shape::Shape;
-use crate::spectral::eigen::Eigenbasis;
+use crate::spectral::eigen::{Eigenbasis, ShapeBasis};
 
 /// Corresponding region sets: the A regions and the B regions of each constraint.
 pub type RegionGroups = Vec<(Vec<u32>, Vec<u32>)>;
@@ -173,28 +173,36 @@ pub const MAX_ALTERNATIVES: usize = 2;
 /// removed at the fourth: over all 479 benchmark pairs it fixed no failure and added one;
 /// docs/decisions.md, "Rearrangements".)
 pub fn candidates(
-    (a, basis_a): (&Shape, &Eigenbasis),
-    (b, basis_b): (&Shape, &Eigenbasis),
-    regions: &Correspondence,
+    side_a: ShapeBasis<'_>,
+    side_b: ShapeBasis<'_>,
+    regions: RegionMatches<'_>,
     with_mirror: bool,
 ) -> Vec<(HypothesisKind, RegionGroups)> {
-    let answer = one_to_one_groups(&regions.matches_one_to_one);
+    let ShapeBasis {
+        shape: a,
+        basis: basis_a,
+    } = side_a;
+    let ShapeBasis {
+        shape: b,
+        basis: basis_b,
+    } = side_b;
+    let answer = one_to_one_groups(regions.one_to_one);
     let mut out = vec![(HypothesisKind::Answer, answer)];
-    let symmetric = crate::regions::symmetry::bipartite_groups(&regions.matches);
+    let symmetric = crate::regions::symmetry::bipartite_groups(regions.matches);
     let choices = GroupChoices::new(regions);
     if !choices.options.is_empty() {
         let d_a = crate::geodesic::region_distance_matrix(
             a,
             &basis_a.mass,
-            regions.regions_a(),
-            regions.graph_a.n_nodes(),
+            regions.labels_a,
+            regions.n_regions_a,
             1.0 / basis_a.input_area.sqrt(),
         );
         let d_b = crate::geodesic::region_distance_matrix(
             b,
             &basis_b.mass,
-            regions.regions_b(),
-            regions.graph_b.n_nodes(),
+            regions.labels_b,
+            regions.n_regions_b,
             1.0 / basis_b.input_area.sqrt(),
         );
         let energy = |pick: &[Option<usize>]| {
@@ -256,14 +264,14 @@ struct GroupChoices {
 }
 
 impl GroupChoices {
-    fn new(regions: &Correspondence) -> GroupChoices {
-        let answer = &regions.matches_one_to_one;
+    fn new(regions: RegionMatches<'_>) -> GroupChoices {
+        let answer = regions.one_to_one;
         let mut choices = GroupChoices {
             fixed: Vec::new(),
             current: Vec::new(),
             options: Vec::new(),
         };
-        for (ra, rb) in crate::regions::symmetry::bipartite_groups(&regions.matches) {
+        for (ra, rb) in crate::regions::symmetry::bipartite_groups(regions.matches) {
             let in_group = |p: &(u32, u32)| ra.binary_search(&p.0).is_ok();
             let mut mine: Vec<(u32, u32)> = answer.iter().copied().filter(in_group).collect();
             mine.sort_unstable();
@@ -411,11 +419,19 @@ impl DistortionProbe {
 /// The energies of hypotheses refined on the same samples, with the orientation of B's
 /// sample triangles where both shapes have consistently oriented `faces`.
 pub fn energies(
-    (a, basis_a): (&Shape, &Eigenbasis),
-    (b, basis_b): (&Shape, &Eigenbasis),
+    side_a: ShapeBasis<'_>,
+    side_b: ShapeBasis<'_>,
     faces: Option<&OrientedFaces>,
     sampled: &[SampledZoomOut],
 ) -> Vec<MapEnergy> {
+    let ShapeBasis {
+        shape: a,
+        basis: basis_a,
+    } = side_a;
+    let ShapeBasis {
+        shape: b,
+        basis: basis_b,
+    } = side_b;
     let Some(first) = sampled.first() else {
         return Vec::new();
     };
@@ -814,14 +830,14 @@ fn signed_turn(vertices: &[[f64; 3]], c: [usize; 3], normals: &[[f64; 3]]) -> f6
 /// B's area (`mass_b`) in region `j` mapped into region `i` of A; the other matches as they
 /// are. Sorted by A region. This keeps the regions reported with a map consistent with it.
 pub fn one_to_one_from_map(
-    regions: &Correspondence,
+    regions: RegionMatches<'_>,
     p2p_ba: &[u32],
     mass_b: &[f64],
 ) -> Vec<(u32, u32)> {
     let choices = GroupChoices::new(regions);
-    let (labels_a, labels_b) = (regions.regions_a(), regions.regions_b());
-    let n_a = regions.graph_a.n_nodes();
-    let mut overlap = vec![0.0; n_a * regions.graph_b.n_nodes()];
+    let (labels_a, labels_b) = (regions.labels_a, regions.labels_b);
+    let n_a = regions.n_regions_a;
+    let mut overlap = vec![0.0; n_a * regions.n_regions_b];
     for (v, &x) in p2p_ba.iter().enumerate() {
         let (i, j) = (labels_a[x as usize] as usize, labels_b[v] as usize);
         overlap[j * n_a + i] += mass_b[v];

@@ -1,6 +1,7 @@
 //! Point-to-point maps from the region correspondence (paper, section 6.4): functional
 //! maps and their refinement ([`fmap`]), the region hypotheses verified at the map level
-//! ([`hypotheses`]), and the whole pointwise job ([`pointwise`]).
+//! ([`hypotheses`]), the pointwise map from regions ([`pointwise`]) and the map onto a
+//! surface ([`surface`]).
 
 pub mod fmap;
 pub mod hypotheses;

@@ -11,19 +11,17 @@ use std::time::Instant;
 use faer::Mat;
 use rayon::prelude::*;
 
-use crate::correspondence::{Correspondence, Params};
 use crate::maps::fmap::{
-    fmap_to_p2p_cancellable, icp_refine_cancellable, multiplication_operators,
-    orientation_operators, project, solve_fmap_commuting_cancellable, zoomout_cancellable,
-    zoomout_on_samples_cancellable, Commutativity, ZoomOutParams,
+    fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, project,
+    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
 };
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, HypothesisKind, RegionGroups, Verdict};
-use crate::multiresolution::{lift_map, lift_regions, working};
-use crate::progress::{check, polled, Cancel, Progress, Stage};
+use crate::progress::{polled, Cancel, Progress, Stage};
+use crate::regions::RegionMatches;
 use crate::shape::Shape;
 use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
-use crate::spectral::eigen::{EigenParams, Eigenbasis};
+use crate::spectral::eigen::{Eigenbasis, ShapeBasis};
 use crate::{Error, Result};
 
 /// Which region matches constrain the functional map.
@@ -208,47 +206,37 @@ pub struct PointwiseMap {
 impl PointwiseMap {
     /// The pointwise map between two shapes whose eigenbases are given (each with at least
     /// `params.n_eigenpairs` pairs, or all the shape has), with the region correspondence
-    /// `regions` (needed unless `params.regions` is `None`).
+    /// `regions` (needed unless `params.regions` is `None`). Reports progress as `stage`
+    /// from the caller's thread, every [`crate::progress::POLL_INTERVAL`], and stops within
+    /// a fraction of a second when it cancels: every loop inside checks the cancel.
     pub fn from_bases(
-        a: &Shape,
-        basis_a: &Eigenbasis,
-        b: &Shape,
-        basis_b: &Eigenbasis,
-        regions: Option<&Correspondence>,
+        a: ShapeBasis<'_>,
+        b: ShapeBasis<'_>,
+        regions: Option<RegionMatches<'_>>,
         params: &PointwiseParams,
+        progress: &mut dyn Progress,
     ) -> Result<PointwiseMap> {
-        let cancel = Cancel::default();
-        PointwiseMap::from_bases_cancellable((a, basis_a), (b, basis_b), regions, params, &cancel)
-    }
-
-    /// As [`PointwiseMap::from_bases`], reporting progress to `progress` as `stage` (from
-    /// the caller's thread, every [`crate::progress::POLL_INTERVAL`]) and stopping within a
-    /// fraction of a second when it cancels: every loop inside checks the cancel (issue 19).
-    pub fn from_bases_with_progress(
-        (a, basis_a): (&Shape, &Eigenbasis),
-        (b, basis_b): (&Shape, &Eigenbasis),
-        regions: Option<&Correspondence>,
-        params: &PointwiseParams,
-        (progress, stage): (&mut dyn Progress, Stage),
-    ) -> Result<PointwiseMap> {
-        polled(progress, stage, (0.0, 1.0), |cancel| {
-            PointwiseMap::from_bases_cancellable(
-                (a, basis_a),
-                (b, basis_b),
-                regions,
-                params,
-                cancel,
-            )
+        polled(progress, Stage::PointwiseMap, (0.0, 1.0), |cancel| {
+            PointwiseMap::solve(a, b, regions, params, cancel)
         })
     }
 
-    fn from_bases_cancellable(
-        (a, basis_a): (&Shape, &Eigenbasis),
-        (b, basis_b): (&Shape, &Eigenbasis),
-        regions: Option<&Correspondence>,
+    /// [`PointwiseMap::from_bases`] on the calling thread, polling `cancel`.
+    fn solve(
+        side_a: ShapeBasis<'_>,
+        side_b: ShapeBasis<'_>,
+        regions: Option<RegionMatches<'_>>,
         params: &PointwiseParams,
         cancel: &Cancel,
     ) -> Result<PointwiseMap> {
+        let ShapeBasis {
+            shape: a,
+            basis: basis_a,
+        } = side_a;
+        let ShapeBasis {
+            shape: b,
+            basis: basis_b,
+        } = side_b;
         params.validate()?;
         let started = Instant::now();
         let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
@@ -263,15 +251,13 @@ impl PointwiseMap {
             None
         };
         let kinds_and_groups: Vec<(HypothesisKind, RegionGroups)> = match regions {
-            // Regions verified already ([`verify_regions`]): their answer is the hypothesis.
-            Some(regions)
-                if params.regions == RegionConstraints::OneToOne && regions.verdict.is_none() =>
-            {
+            // Regions verified already: their answer is the only hypothesis.
+            Some(regions) if params.regions == RegionConstraints::OneToOne && !regions.verified => {
                 let with_mirror = params.orientation && faces.is_some();
                 if params.hypotheses {
-                    hypotheses::candidates((a, basis_a), (b, basis_b), regions, with_mirror)
+                    hypotheses::candidates(side_a, side_b, regions, with_mirror)
                 } else if with_mirror {
-                    hypotheses::candidates((a, basis_a), (b, basis_b), regions, true)
+                    hypotheses::candidates(side_a, side_b, regions, true)
                         .into_iter()
                         .filter(|(kind, _)| {
                             matches!(kind, HypothesisKind::Answer | HypothesisKind::Mirror)
@@ -292,8 +278,8 @@ impl PointwiseMap {
             .filter(|_| params.orientation_term > 0.0)
             .map(|(fa, fb)| (fa.as_slice(), fb.as_slice()));
         let features = Features::new(
-            (a, basis_a),
-            (b, basis_b),
+            side_a,
+            side_b,
             regions,
             &candidate_refs,
             orientation_faces,
@@ -311,8 +297,8 @@ impl PointwiseMap {
         let t = Instant::now();
         let (fmap_ab, p2p_ba, verdict) = if fmaps.len() > 1 {
             let (verdict, chosen_map) = verified(
-                (a, basis_a),
-                (b, basis_b),
+                side_a,
+                side_b,
                 faces.as_ref(),
                 kinds,
                 &fmaps,
@@ -326,7 +312,7 @@ impl PointwiseMap {
                     let fmap = verdict.scores[verdict.chosen].fmap_ab.clone();
                     let p2p = match chosen_map {
                         Some(p2p) => p2p,
-                        None => fmap_to_p2p_cancellable(
+                        None => fmap_to_p2p(
                             fmap.as_ref(),
                             basis_a.vectors.as_ref(),
                             basis_b.vectors.as_ref(),
@@ -362,7 +348,7 @@ impl PointwiseMap {
 /// The region constraints of the map: the groups of matched regions (none for
 /// [`RegionConstraints::None`]).
 fn constraint_groups(
-    regions: Option<&Correspondence>,
+    regions: Option<RegionMatches<'_>>,
     kind: RegionConstraints,
 ) -> Result<Vec<(Vec<u32>, Vec<u32>)>> {
     if kind == RegionConstraints::None {
@@ -408,16 +394,16 @@ fn refine(
     );
     match &params.refinement {
         Refinement::None => {
-            let p2p = fmap_to_p2p_cancellable(fmap.as_ref(), phi_a, phi_b, cancel)?;
+            let p2p = fmap_to_p2p(fmap.as_ref(), phi_a, phi_b, cancel)?;
             Ok((fmap.clone(), p2p))
         }
         Refinement::ZoomOut(z) => {
             let z = clamped(z, (basis_a, basis_b), k);
-            zoomout_cancellable(fmap.as_ref(), bases, &z, cancel)
+            zoomout(fmap.as_ref(), bases, &z, cancel)
         }
         Refinement::Icp(iterations) => {
             let sample_size = ZoomOutParams::default().sample_size;
-            icp_refine_cancellable(fmap.as_ref(), bases, (*iterations, sample_size), cancel)
+            icp_refine(fmap.as_ref(), bases, (*iterations, sample_size), cancel)
         }
     }
 }
@@ -425,14 +411,15 @@ fn refine(
 /// The hypotheses' functional maps `fmaps` refined by ZoomOut on the same samples and
 /// judged by [`hypotheses::energies`]: the verdict.
 fn verified(
-    (a, basis_a): (&Shape, &Eigenbasis),
-    (b, basis_b): (&Shape, &Eigenbasis),
+    side_a: ShapeBasis<'_>,
+    side_b: ShapeBasis<'_>,
     faces: Option<&hypotheses::OrientedFaces>,
     kinds: Vec<HypothesisKind>,
     fmaps: &[Mat<f64>],
     (params, k): (&PointwiseParams, usize),
     cancel: &Cancel,
 ) -> Result<(Verdict, Option<Vec<u32>>)> {
+    let (a, basis_a, basis_b) = (side_a.shape, side_a.basis, side_b.basis);
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
     let bases = (
         (phi_a, basis_a.mass.as_slice()),
@@ -445,10 +432,10 @@ fn verified(
     let decision = clamped(&decision, (basis_a, basis_b), k);
     let sampled = fmaps
         .par_iter()
-        .map(|fmap| zoomout_on_samples_cancellable(fmap.as_ref(), bases, &decision, cancel))
+        .map(|fmap| zoomout_on_samples(fmap.as_ref(), bases, &decision, cancel))
         .collect::<Result<Vec<_>>>()?;
     cancel.check()?;
-    let energies = hypotheses::energies((a, basis_a), (b, basis_b), faces, &sampled);
+    let energies = hypotheses::energies(side_a, side_b, faces, &sampled);
     let sample_maps: Vec<&[u32]> = sampled.iter().map(|s| s.p2p_ba.as_slice()).collect();
     let sample_fmaps = sampled.iter().map(|s| s.fmap_ab.clone()).collect();
     let mut verdict = hypotheses::choose(
@@ -462,9 +449,8 @@ fn verified(
     let mut chosen_map = None;
     if let (Some(rival), Some(faces)) = (verdict.close_call(), faces) {
         cancel.check()?;
-        let convert = |h: usize| {
-            fmap_to_p2p_cancellable(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel)
-        };
+        let convert =
+            |h: usize| fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel);
         let (chosen_p2p, rival_p2p) = (convert(verdict.chosen)?, convert(rival)?);
         let consistency = (
             hypotheses::full_consistency(a, faces, &chosen_p2p),
@@ -599,14 +585,22 @@ impl Features {
     /// `orientation_faces`: both shapes' consistently oriented faces when the orientation
     /// term is on.
     fn new(
-        (a, basis_a): (&Shape, &Eigenbasis),
-        (b, basis_b): (&Shape, &Eigenbasis),
-        regions: Option<&Correspondence>,
+        side_a: ShapeBasis<'_>,
+        side_b: ShapeBasis<'_>,
+        regions: Option<RegionMatches<'_>>,
         candidates: &[&[(Vec<u32>, Vec<u32>)]],
         orientation_faces: Option<FacePair<'_>>,
         params: &PointwiseParams,
         k: usize,
     ) -> Result<Features> {
+        let ShapeBasis {
+            shape: a,
+            basis: basis_a,
+        } = side_a;
+        let ShapeBasis {
+            shape: b,
+            basis: basis_b,
+        } = side_b;
         let (mut sets_a, mut sets_b) = (Vec::new(), Vec::new());
         let index = |sets: &mut Vec<Vec<u32>>, set: &Vec<u32>| {
             sets.iter().position(|s| s == set).unwrap_or_else(|| {
@@ -627,8 +621,8 @@ impl Features {
         let side = |shape, basis, labels, sets: &[Vec<u32>], faces| {
             SideFeatures::new(shape, basis, labels, sets, params, k, multiplication, faces)
         };
-        let labels_a = regions.map(|r| (r.regions_a(), r.graph_a.n_nodes()));
-        let labels_b = regions.map(|r| (r.regions_b(), r.graph_b.n_nodes()));
+        let labels_a = regions.map(|r| (r.labels_a, r.n_regions_a));
+        let labels_b = regions.map(|r| (r.labels_b, r.n_regions_b));
         Ok(Features {
             a: side(
                 a,
@@ -675,7 +669,7 @@ impl Features {
         };
         let (coef_a, multiplication_a, orientation_a) = gather(&self.a, true);
         let (coef_b, multiplication_b, orientation_b) = gather(&self.b, false);
-        solve_fmap_commuting_cancellable(
+        solve_fmap_commuting(
             coef_a.as_ref(),
             coef_b.as_ref(),
             (&basis_a.values, &basis_b.values, params.laplacian_weight),
@@ -696,251 +690,18 @@ impl Features {
     }
 }
 
-/// Everything from two shapes: eigenbases, region correspondence, pointwise map.
-#[derive(Debug, Clone)]
-pub struct PointwiseCorrespondence {
-    /// The region correspondence the map is built on.
-    pub regions: Correspondence,
-    /// The point-to-point map from B to A.
-    pub map: PointwiseMap,
-    /// Seconds of A's eigenbasis.
-    pub eigenbasis_a: f64,
-    /// Seconds of B's eigenbasis.
-    pub eigenbasis_b: f64,
-    /// Seconds of building the proxies of dense shapes and bringing the regions and the map
-    /// back to every input vertex (0 at full resolution, [`Params::multiresolution`]).
-    pub proxies: f64,
-    /// Seconds of the whole call.
-    pub total: f64,
-}
-
-impl PointwiseCorrespondence {
-    /// The verdict behind the answer: the map's own when it verified hypotheses, else the
-    /// regions'.
-    pub fn verdict(&self) -> Option<&Verdict> {
-        self.map.verdict.as_ref().or(self.regions.verdict.as_ref())
-    }
-
-    /// The confidence of the answer in [0, 1] ([`PointwiseCorrespondence::verdict`]; None
-    /// when nothing was verified).
-    pub fn confidence(&self) -> Option<f64> {
-        self.verdict().map(|v| v.confidence)
-    }
-}
-
-impl PointwiseCorrespondence {
-    /// Region correspondence and pointwise map of two shapes. Each eigenbasis is computed
-    /// once, with `pointwise.n_eigenpairs` pairs; region matching uses its first
-    /// `params.eigen.n_eigenpairs`.
-    pub fn compute(
-        a: &Shape,
-        b: &Shape,
-        params: &Params,
-        pointwise: &PointwiseParams,
-        progress: &mut dyn Progress,
-    ) -> Result<PointwiseCorrespondence> {
-        params.validate()?;
-        pointwise.validate()?;
-        let eigen = basis_params(params, pointwise);
-        params
-            .budget
-            .check(&PointwiseCorrespondence::job(a, b, params, pointwise))?;
-        params.budget.run(progress, |progress| {
-            let started = Instant::now();
-            let proxies = params.multiresolution.proxies([a, b], &eigen, progress)?;
-            let built = started.elapsed().as_secs_f64();
-            let [proxy_a, proxy_b] = &proxies;
-            let (working_a, working_b) = (working(a, proxy_a), working(b, proxy_b));
-            let mut result = PointwiseCorrespondence::compute_within(
-                (working_a, working_b),
-                &eigen,
-                params,
-                pointwise,
-                progress,
-            )?;
-            let t = Instant::now();
-            lift_regions(&mut result.regions, [proxy_a.as_ref(), proxy_b.as_ref()]);
-            result.map.p2p_ba = lift_map((a, proxy_a), (b, proxy_b), &result.map.p2p_ba, progress)?;
-            if proxy_a.is_some() || proxy_b.is_some() {
-                result.proxies = built + t.elapsed().as_secs_f64();
-            }
-            result.regions.timings.proxies = result.proxies;
-            result.total = started.elapsed().as_secs_f64();
-            Ok(result)
-        })
-    }
-
-    /// What [`PointwiseCorrespondence::compute`] will do on these shapes, for
-    /// [`crate::budget::Budget::check`]: the chosen map converted at full resolution, and a
-    /// close call's rival too when the hypotheses are verified.
-    pub fn job(
-        a: &Shape,
-        b: &Shape,
-        params: &Params,
-        pointwise: &PointwiseParams,
-    ) -> crate::budget::Job {
-        let eigen = basis_params(params, pointwise);
-        let size = match &pointwise.refinement {
-            Refinement::ZoomOut(z) => z.k_end,
-            _ => pointwise.fmap_size,
-        };
-        let sizes = [a, b].map(|s| params.multiresolution.working_size(s));
-        crate::budget::Job {
-            conversions: if params.verify_hypotheses { 3 } else { 1 },
-            conversion_size: size.min(eigen.n_eigenpairs),
-            ..crate::budget::regions_job(sizes, &eigen, false)
-        }
-    }
-
-    /// [`PointwiseCorrespondence::compute`] once the budget has accepted the job.
-    fn compute_within(
-        (a, b): (&Shape, &Shape),
-        eigen: &EigenParams,
-        params: &Params,
-        pointwise: &PointwiseParams,
-        progress: &mut dyn Progress,
-    ) -> Result<PointwiseCorrespondence> {
-        let started = Instant::now();
-        let ([basis_a, basis_b], [eigenbasis_a, eigenbasis_b]) =
-            Eigenbasis::pair((a, b), eigen, progress)?;
-        let (regions, map) =
-            regions_and_map((a, &basis_a), (b, &basis_b), params, pointwise, progress)?;
-        Ok(PointwiseCorrespondence {
-            regions,
-            map,
-            eigenbasis_a,
-            eigenbasis_b,
-            proxies: 0.0,
-            total: started.elapsed().as_secs_f64(),
-        })
-    }
-}
-
-/// The eigensolver's parameters of a pointwise job: enough eigenpairs for the map and the
-/// regions, computed once per shape.
-pub(crate) fn basis_params(params: &Params, pointwise: &PointwiseParams) -> EigenParams {
-    EigenParams {
-        n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
-        ..params.eigen.clone()
-    }
-}
-
-/// The regions (on the first `params.eigen.n_eigenpairs` of the bases) and the map (on all of
-/// them). With `params.verify_hypotheses`, the hypotheses are verified once, by the map on
-/// its larger basis (on FAUST_r, verifying on the regions' 50 eigenpairs failed 15 of 126
-/// pairs, on the map's 100 one: docs/tails.md), and the regions follow the chosen map
-/// ([`hypotheses::one_to_one_from_map`]) and carry its verdict.
-pub fn regions_and_map(
-    (a, basis_a): (&Shape, &Eigenbasis),
-    (b, basis_b): (&Shape, &Eigenbasis),
-    params: &Params,
-    pointwise: &PointwiseParams,
-    progress: &mut dyn Progress,
-) -> Result<(Correspondence, PointwiseMap)> {
-    let k = params.eigen.n_eigenpairs;
-    let unverified = Params {
-        verify_hypotheses: false,
-        ..params.clone()
-    };
-    let mut regions = Correspondence::from_bases(
-        a,
-        &truncated(basis_a, k),
-        b,
-        &truncated(basis_b, k),
-        &unverified,
-        progress,
-    )?;
-    check(progress, Stage::PointwiseMap, 0.0)?;
-    let pointwise = PointwiseParams {
-        hypotheses: pointwise.hypotheses && params.verify_hypotheses,
-        orientation: pointwise.orientation && params.verify_hypotheses,
-        ..pointwise.clone()
-    };
-    let map = PointwiseMap::from_bases_with_progress(
-        (a, basis_a),
-        (b, basis_b),
-        Some(&regions),
-        &pointwise,
-        (progress, Stage::PointwiseMap),
-    )?;
-    if let Some(verdict) = &map.verdict {
-        regions.matches_one_to_one =
-            hypotheses::one_to_one_from_map(&regions, &map.p2p_ba, &basis_b.mass);
-        regions.verdict = Some(verdict.clone());
-    }
-    check(progress, Stage::PointwiseMap, 1.0)?;
-    Ok((regions, map))
-}
-
-/// Verifies the one-to-one answer of `regions` at the map level on the regions' own
-/// eigenbases (ZoomOut up to their size): the hypotheses of [`hypotheses::candidates`] are
-/// refined and judged, the one-to-one matches become those that agree best with the chosen
-/// map ([`hypotheses::one_to_one_from_map`]) and the verdict is kept with them. Nothing
-/// changes when there is a single hypothesis.
-pub fn verify_regions(
-    (a, basis_a): (&Shape, &Eigenbasis),
-    (b, basis_b): (&Shape, &Eigenbasis),
-    regions: &mut Correspondence,
-    progress: &mut dyn Progress,
-) -> Result<()> {
-    if regions.matches_one_to_one.is_empty() {
-        return Ok(());
-    }
-    let n = basis_a.len().min(basis_b.len());
-    let defaults = PointwiseParams::default();
-    let params = PointwiseParams {
-        n_eigenpairs: n,
-        fmap_size: defaults.fmap_size.min(n),
-        refinement: Refinement::ZoomOut(ZoomOutParams {
-            k_end: n,
-            ..Default::default()
-        }),
-        ..defaults
-    };
-    let map = PointwiseMap::from_bases_with_progress(
-        (a, basis_a),
-        (b, basis_b),
-        Some(regions),
-        &params,
-        (progress, Stage::SymmetryBreaking),
-    )?;
-    if let Some(verdict) = map.verdict {
-        regions.matches_one_to_one =
-            hypotheses::one_to_one_from_map(regions, &map.p2p_ba, &basis_b.mass);
-        regions.verdict = Some(verdict);
-    }
-    Ok(())
-}
-
-/// The first `k` eigenpairs of a basis (a copy; the eigenvectors of a larger solve agree
-/// with a smaller one's to round-off).
-pub fn truncated(basis: &Eigenbasis, k: usize) -> Eigenbasis {
-    let k = k.min(basis.len());
-    Eigenbasis {
-        values: basis.values[..k].to_vec(),
-        vectors: basis.vectors.subcols(0, k).to_owned(),
-        mass: basis.mass.clone(),
-        input_area: basis.input_area,
-    }
-}
-
 /// The corresponding region sets that constrain the map: one pair per one-to-one match,
 /// or one per group of symmetric matches (the connected components of their bipartite
 /// graph, [`crate::regions::symmetry::bipartite_groups`]).
-pub fn region_groups(
-    regions: &Correspondence,
-    kind: RegionConstraints,
-) -> Vec<(Vec<u32>, Vec<u32>)> {
+pub fn region_groups(regions: RegionMatches<'_>, kind: RegionConstraints) -> RegionGroups {
     match kind {
         RegionConstraints::None => Vec::new(),
         RegionConstraints::OneToOne => regions
-            .matches_one_to_one
+            .one_to_one
             .iter()
             .map(|&(i, j)| (vec![i], vec![j]))
             .collect(),
-        RegionConstraints::Symmetric => {
-            crate::regions::symmetry::bipartite_groups(&regions.matches)
-        }
+        RegionConstraints::Symmetric => crate::regions::symmetry::bipartite_groups(regions.matches),
     }
 }
 

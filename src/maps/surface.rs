@@ -16,7 +16,6 @@
 
 use rayon::prelude::*;
 
-use crate::multiresolution::mean_edge_length;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::neighbors::PointTree;
 use crate::shape::surface_point::{
@@ -26,7 +25,7 @@ use crate::shape::{Shape, ShapeKind};
 use crate::{Error, Result};
 
 /// Images further than this many mean edges of A from a vertex's own image are left out of
-/// its mean (the map tears between them). Not tuned: as [`crate::multiresolution`]'s.
+/// its mean (the map tears between them). Not tuned: as the proxies' lifting ([`crate::pipeline::multiresolution`]).
 const TEAR_EDGES: f64 = 3.0;
 
 /// Neighbours of a point of a point cloud B whose images are averaged (a mesh vertex has
@@ -48,13 +47,8 @@ pub struct SurfaceMap {
 impl SurfaceMap {
     /// The surface map of the vertex map `p2p_ba` (for every vertex of B, a vertex of A), as
     /// described in the module docs. Errors when `p2p_ba` does not fit the shapes.
-    pub fn from_vertex_map(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Result<SurfaceMap> {
-        SurfaceMap::from_vertex_map_with_progress(a, b, p2p_ba, &mut crate::NoProgress)
-    }
-
-    /// As [`SurfaceMap::from_vertex_map`], reporting progress ([`Stage::Transfer`]) and
-    /// honouring cancellation.
-    pub fn from_vertex_map_with_progress(
+    /// Reports progress as [`Stage::Transfer`] and honours cancellation.
+    pub fn from_vertex_map(
         a: &Shape,
         b: &Shape,
         p2p_ba: &[u32],
@@ -113,7 +107,7 @@ fn surface_points(
 ) -> Result<Vec<SurfacePoint>> {
     let neighbors = neighbors_of(b);
     let incident = (a.kind() == ShapeKind::Mesh).then(|| a.triangles_around_vertices());
-    let tear2 = (TEAR_EDGES * mean_edge_length(a)).powi(2);
+    let tear2 = (TEAR_EDGES * a.mean_edge_length()).powi(2);
     let pa = a.vertices();
     let representative = b.representative();
     let n_b = b.n_vertices();

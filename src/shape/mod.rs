@@ -592,6 +592,35 @@ impl Shape {
             .collect()
     }
 
+    /// Mean edge length; for a point cloud, the mean distance to the nearest other point
+    /// (the scale the proxies' lifting and the surface map measure tears in).
+    pub fn mean_edge_length(&self) -> f64 {
+        let p = self.vertices();
+        let edges = self.edges();
+        if !edges.is_empty() {
+            return edges
+                .iter()
+                .map(|&(i, j)| distance(&p[i as usize], &p[j as usize]))
+                .sum::<f64>()
+                / edges.len() as f64;
+        }
+        let active: Vec<[f64; 3]> = self
+            .active_vertices()
+            .iter()
+            .map(|&v| p[v as usize])
+            .collect();
+        let tree = PointTree::new(&active);
+        active
+            .iter()
+            .map(|q| {
+                tree.nearest_k(q, 2)
+                    .last()
+                    .map_or(0.0, |&(_, d2)| d2.sqrt())
+            })
+            .sum::<f64>()
+            / active.len() as f64
+    }
+
     /// Undirected edges between active vertices, each once as (low, high), sorted: mesh edges,
     /// or the symmetric k-nearest-neighbour graph (k = [`POINT_CLOUD_GRAPH_K`]) of a point cloud.
     pub fn edges(&self) -> Vec<(u32, u32)> {

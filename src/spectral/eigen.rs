@@ -20,7 +20,7 @@ use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::progress::{check, polled, NoProgress, Progress, Stage};
+use crate::progress::{check, polled, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::laplacian::Laplacian;
 use crate::spectral::sparse::SparseCholesky;
@@ -113,6 +113,22 @@ pub const MAX_EIGENPAIRS: usize = 1000;
 /// Below this many active vertices the dense eigensolver is used.
 const DENSE_LIMIT: usize = 600;
 
+/// A shape with its eigenbasis: what every stage after the eigensolver takes.
+#[derive(Debug, Clone, Copy)]
+pub struct ShapeBasis<'a> {
+    /// The shape.
+    pub shape: &'a Shape,
+    /// Its eigenbasis ([`Eigenbasis::compute`]).
+    pub basis: &'a Eigenbasis,
+}
+
+impl<'a> ShapeBasis<'a> {
+    /// The shape and its basis side by side.
+    pub fn new(shape: &'a Shape, basis: &'a Eigenbasis) -> Self {
+        ShapeBasis { shape, basis }
+    }
+}
+
 /// Eigenvalues and M-orthonormal eigenvectors of a shape's Laplacian (unit-area shape).
 #[derive(Debug, Clone)]
 pub struct Eigenbasis {
@@ -128,13 +144,9 @@ pub struct Eigenbasis {
 }
 
 impl Eigenbasis {
-    /// Laplacian and eigenpairs of a shape.
-    pub fn compute(shape: &Shape, params: &EigenParams) -> Result<Eigenbasis> {
-        Eigenbasis::compute_with_progress(shape, params, &mut NoProgress)
-    }
-
-    /// As [`Eigenbasis::compute`], reporting progress and honouring cancellation.
-    pub fn compute_with_progress(
+    /// Laplacian and eigenpairs of a shape, reporting progress and honouring cancellation
+    /// ([`crate::NoProgress`] for neither).
+    pub fn compute(
         shape: &Shape,
         params: &EigenParams,
         progress: &mut dyn Progress,
@@ -177,8 +189,8 @@ impl Eigenbasis {
     ) -> Result<([Eigenbasis; 2], [f64; 2])> {
         let timed = |shape: &Shape, name: char, progress: &mut dyn Progress| {
             let started = std::time::Instant::now();
-            let basis = Eigenbasis::compute_with_progress(shape, params, progress)
-                .map_err(|e| e.in_shape(name))?;
+            let basis =
+                Eigenbasis::compute(shape, params, progress).map_err(|e| e.in_shape(name))?;
             Ok::<_, Error>((basis, started.elapsed().as_secs_f64()))
         };
         let largest = a.active_vertices().len().max(b.active_vertices().len());
@@ -240,7 +252,7 @@ pub fn eigensolver_bytes(n: usize, params: &EigenParams) -> u64 {
 fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
     let n = shape.active_vertices().len();
     let needed = eigensolver_bytes(n, params);
-    if let Some(available) = crate::budget::available_bytes().filter(|&a| needed > a) {
+    if let Some(available) = crate::system::available_bytes().filter(|&a| needed > a) {
         let gb = |b: u64| b as f64 / 1e9;
         return Err(Error::InvalidParameter {
             name: "eigenpairs",

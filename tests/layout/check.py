@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
 """The code stays easy to see: no Rust module over MAX_MODULE_LINES lines and no function
-over MAX_FUNCTION_LINES lines (issue 17), in the pipeline (src/) and the workspace crates
-(crates/). Tests (`tests.rs`, files under tests/) count too: they are read as often as the code.
+over MAX_FUNCTION_LINES lines, in the library (src/) and the workspace crates (crates/).
+Tests (`tests.rs`, files under tests/) count too: they are read as often as the code.
+
+The stages never call up (docs/design.md, "Code layout"): no file under the STAGES folders
+uses the modules that assemble them (UPWARD: `src/pipeline/`, the collections, the C API,
+the option table), neither by path nor by the crate root's re-exports of the pipeline's types.
 
     python3 tests/layout/check.py [--list]     # exit 1 and one line per offender
 
@@ -16,6 +20,13 @@ from pathlib import Path
 MAX_MODULE_LINES = 1200
 MAX_FUNCTION_LINES = 150
 ROOT = Path(__file__).resolve().parents[2]
+STAGES = ("src/shape", "src/spectral", "src/regions", "src/maps")
+UPWARD = re.compile(
+    r"\b(?:crate|shapecorr)::(?:pipeline|collection|ffi|options|transfer)\b"
+    r"|\bcrate::(?:Correspondence|Params|PointwiseCorrespondence|Symmetry)\b"
+    r"|\bcrate::\{[^}]*\b(?:Correspondence|Params|PointwiseCorrespondence|Symmetry)\b"
+    r"|\bsuper::super::(?:pipeline|collection|ffi|options)\b"
+)
 
 
 def code_only(text):
@@ -98,8 +109,19 @@ def long_functions(path):
             yield m.group(1), first, last - first + 1
 
 
+def upward_uses(path):
+    code = code_only(path.read_text())
+    for m in UPWARD.finditer(code):
+        yield code.count("\n", 0, m.start()) + 1, m.group(0)
+
+
 def main():
     offenders = []
+    for stage in STAGES:
+        for path in sorted((ROOT / stage).rglob("*.rs")):
+            for line, use in upward_uses(path):
+                rel = path.relative_to(ROOT)
+                offenders.append(f"{rel}:{line}: a stage uses `{use}` (stages never import the pipeline)")
     for folder in ("src", "crates", "tests"):
         for path in sorted((ROOT / folder).rglob("*.rs")):
             rel = path.relative_to(ROOT)

@@ -4,9 +4,9 @@ use std::path::Path;
 
 use serde_json::json;
 use shapecorr::colors::{coordinate_colors, region_colors};
-use shapecorr::correspondence::Correspondence;
 use shapecorr::maps::hypotheses::Verdict;
 use shapecorr::options::{OptionGroup, OptionValue, Options, OPTIONS};
+use shapecorr::pipeline::Correspondence;
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::{Error, Shape};
@@ -123,8 +123,7 @@ pub fn peak_memory_mib() -> Option<f64> {
 
 /// `result.json`'s `budget`: the job's estimated peak memory and time (what the memory
 /// ceiling and the time limit were checked against) and the process's measured peak.
-pub fn budget_json(job: &shapecorr::budget::Job) -> serde_json::Value {
-    let estimate = shapecorr::budget::estimate(job);
+pub fn budget_json(estimate: &shapecorr::pipeline::budget::Estimate) -> serde_json::Value {
     json!({
         "memory_estimate_mib": estimate.mib(),
         "time_estimate_s": estimate.seconds,

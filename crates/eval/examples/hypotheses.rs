@@ -14,11 +14,13 @@
 
 use std::path::PathBuf;
 
-use shapecorr::correspondence::Params;
 use shapecorr::maps::fmap::fmap_to_p2p;
-use shapecorr::maps::pointwise::{truncated, PointwiseParams};
+use shapecorr::maps::pointwise::PointwiseParams;
+use shapecorr::pipeline::pointwise::truncated;
+use shapecorr::pipeline::Params;
+use shapecorr::progress::Cancel;
 use shapecorr::progress::NoProgress;
-use shapecorr::spectral::eigen::EigenParams;
+use shapecorr::spectral::eigen::{EigenParams, ShapeBasis};
 use shapecorr_eval::bench_pointwise::score_maps;
 use shapecorr_eval::bench_store::{BasisCache, ShapeStore};
 use shapecorr_eval::datasets::{default_data_root, pair_list, Pair};
@@ -101,9 +103,9 @@ fn one_pair(
     );
     let t = std::time::Instant::now();
     // The pipeline's path (`p2p`): unverified regions, hypotheses verified by the map.
-    let (_, map) = shapecorr::maps::pointwise::regions_and_map(
-        (a, basis_a),
-        (b, basis_b),
+    let (_, map) = shapecorr::pipeline::pointwise::regions_and_map(
+        ShapeBasis::new(a, basis_a),
+        ShapeBasis::new(b, basis_b),
         params,
         pointwise,
         &mut NoProgress,
@@ -120,15 +122,16 @@ fn one_pair(
     let maps: Vec<(String, Vec<u32>, f64)> = verdict
         .scores
         .iter()
-        .map(|h| {
+        .map(|h| -> shapecorr::Result<_> {
             let p2p = fmap_to_p2p(
                 h.fmap_ab.as_ref(),
                 basis_a.vectors.as_ref(),
                 basis_b.vectors.as_ref(),
-            );
-            (h.kind.name(), p2p, 0.0)
+                &Cancel::default(),
+            )?;
+            Ok((h.kind.name(), p2p, 0.0))
         })
-        .collect();
+        .collect::<shapecorr::Result<_>>()?;
     let mut maps = maps;
     // Full-resolution orientation kept and coverage of A's vertices (the close call's
     // `full_consistency` is their product).

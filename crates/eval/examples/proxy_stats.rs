@@ -4,7 +4,7 @@
 //!
 //!     cargo run --release -p shapecorr-eval --example proxy_stats -- A.ply B.ply ...
 
-use shapecorr::multiresolution::DEFAULT_PROXY_VERTICES;
+use shapecorr::pipeline::multiresolution::DEFAULT_PROXY_VERTICES;
 use shapecorr::shape::proxy::Proxy;
 use shapecorr::{ReadAs, Shape};
 fn main() {

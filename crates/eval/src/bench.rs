@@ -11,10 +11,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::bench_store::{BasisCache, ShapeStore};
 use crate::datasets::{pair_list, Pair};
-use shapecorr::correspondence::{Correspondence, Params, Timings};
 use shapecorr::evaluation::{score_correspondence, RegionScores};
-use shapecorr::maps::pointwise::truncated;
+use shapecorr::pipeline::pointwise::truncated;
+use shapecorr::pipeline::{Correspondence, Params, Timings};
 use shapecorr::progress::NoProgress;
+use shapecorr::spectral::eigen::ShapeBasis;
 use shapecorr::Result;
 
 /// The outcome of one pair.
@@ -58,7 +59,12 @@ pub fn bench_regions(
     let mut results = Vec::with_capacity(pairs.len());
     for (index, pair) in pairs.iter().enumerate() {
         let outcome = region_pair(&mut store, pair, params, &|a, ba, b, bb, p| {
-            Correspondence::from_bases(a, ba, b, bb, p, &mut NoProgress)
+            Correspondence::from_bases(
+                ShapeBasis::new(a, ba),
+                ShapeBasis::new(b, bb),
+                p,
+                &mut NoProgress,
+            )
         })?;
         report(index, pairs.len(), &outcome);
         results.push(outcome);

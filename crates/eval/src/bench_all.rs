@@ -26,11 +26,13 @@ use crate::bench_pointwise::{pointwise_pair, select_methods, write_curves, PairS
 use crate::bench_store::{BasisCache, ProgressBar, ResultLog, ShapeStore};
 use crate::datasets::{discover, Dataset, Pair};
 use crate::reeb::{reeb_correspondence, ReebParams};
-use shapecorr::correspondence::{Correspondence, Params, Timings};
-use shapecorr::maps::pointwise::{PointwiseCorrespondence, PointwiseParams, PointwiseTimings};
+use shapecorr::maps::pointwise::{PointwiseParams, PointwiseTimings};
+use shapecorr::pipeline::PointwiseCorrespondence;
+use shapecorr::pipeline::{Correspondence, Params, Timings};
 use shapecorr::progress::NoProgress;
 use shapecorr::shape::Shape;
 use shapecorr::spectral::eigen::EigenParams;
+use shapecorr::spectral::eigen::ShapeBasis;
 use shapecorr::ReadAs;
 use shapecorr::{Error, Result};
 
@@ -322,7 +324,12 @@ fn run_dataset(p: &AllParams, dataset: &Dataset) -> Result<DatasetResults> {
         &pair_key,
         &mut |pair| {
             region_pair(&mut store, pair, params, &|a, ba, b, bb, pp| {
-                Correspondence::from_bases(a, ba, b, bb, pp, &mut NoProgress)
+                Correspondence::from_bases(
+                    ShapeBasis::new(a, ba),
+                    ShapeBasis::new(b, bb),
+                    pp,
+                    &mut NoProgress,
+                )
             })
         },
     )?;

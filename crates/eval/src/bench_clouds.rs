@@ -19,12 +19,13 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::datasets::Pair;
 use crate::plot::{line_chart_png, Chart, Rendered, Series};
-use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::region_accuracy;
+use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::progress::NoProgress;
 use shapecorr::shape::neighbors::PointTree;
 use shapecorr::shape::{Shape, ShapeKind, MIN_VERTICES};
 use shapecorr::spectral::eigen::Eigenbasis;
+use shapecorr::spectral::eigen::ShapeBasis;
 use shapecorr::spectral::laplacian::Laplacian;
 use shapecorr::synth::{sample_points, FigureMesh};
 use shapecorr::{Error, Result};
@@ -446,16 +447,15 @@ pub fn cloud_trials(
                     let (result, labels_a, extra_seconds) = if mode == MESH_TO_CLOUD {
                         if basis_a.is_none() {
                             let t = Instant::now();
-                            let basis = Eigenbasis::compute(a, &params.eigen)?;
+                            let basis = Eigenbasis::compute(a, &params.eigen, &mut NoProgress)?;
                             basis_a = Some((basis, t.elapsed().as_secs_f64()));
                         }
                         let (basis, t_a) = basis_a.as_ref().expect("computed above");
-                        let basis_b = Eigenbasis::compute(&shape_b, &params.eigen)?;
+                        let basis_b =
+                            Eigenbasis::compute(&shape_b, &params.eigen, &mut NoProgress)?;
                         let result = Correspondence::from_bases(
-                            a,
-                            basis,
-                            &shape_b,
-                            &basis_b,
+                            ShapeBasis::new(a, basis),
+                            ShapeBasis::new(&shape_b, &basis_b),
                             params,
                             &mut NoProgress,
                         )?;

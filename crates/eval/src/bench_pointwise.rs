@@ -20,15 +20,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::bench_store::{BasisCache, ShapeStore};
 use crate::datasets::{pair_list, Pair};
-use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
-use shapecorr::maps::pointwise::{
-    truncated, PointwiseMap, PointwiseParams, Refinement, RegionConstraints,
-};
+use shapecorr::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement, RegionConstraints};
+use shapecorr::pipeline::pointwise::truncated;
+use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::progress::NoProgress;
 use shapecorr::shape::Shape;
 use shapecorr::spectral::descriptors::WksParams;
 use shapecorr::spectral::eigen::EigenParams;
+use shapecorr::spectral::eigen::ShapeBasis;
 use shapecorr::{Error, Result};
 
 /// Seed of the ground-truth sample.
@@ -299,16 +299,16 @@ pub fn pointwise_pair(
     let eigen_seconds = basis_a.seconds + basis_b.seconds;
     let t = Instant::now();
     // The maps verify the hypotheses themselves, on their larger basis
-    // (shapecorr::maps::pointwise::regions_and_map).
+    // (shapecorr::pipeline::pointwise::regions_and_map).
     let unverified = Params {
         verify_hypotheses: false,
         ..params.clone()
     };
+    let k = params.eigen.n_eigenpairs;
+    let (truncated_a, truncated_b) = (truncated(&basis_a.basis, k), truncated(&basis_b.basis, k));
     let regions = Correspondence::from_bases(
-        a,
-        &truncated(&basis_a.basis, params.eigen.n_eigenpairs),
-        b,
-        &truncated(&basis_b.basis, params.eigen.n_eigenpairs),
+        ShapeBasis::new(a, &truncated_a),
+        ShapeBasis::new(b, &truncated_b),
         &unverified,
         &mut NoProgress,
     )?;
@@ -316,8 +316,13 @@ pub fn pointwise_pair(
     let mut maps = Vec::with_capacity(methods.len());
     for (name, method) in methods {
         let t = Instant::now();
-        let map =
-            PointwiseMap::from_bases(a, &basis_a.basis, b, &basis_b.basis, Some(&regions), method)?;
+        let map = PointwiseMap::from_bases(
+            ShapeBasis::new(a, &basis_a.basis),
+            ShapeBasis::new(b, &basis_b.basis),
+            Some(regions.matches_view()),
+            method,
+            &mut NoProgress,
+        )?;
         let uses_regions = method.regions != RegionConstraints::None;
         let seconds = t.elapsed().as_secs_f64()
             + eigen_seconds

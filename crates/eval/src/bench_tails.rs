@@ -15,11 +15,14 @@ use crate::bench_pointwise::score_maps;
 use crate::bench_store::{BasisCache, ResultLog, ShapeStore};
 use crate::datasets::{discover, Pair};
 use crate::tails::{error_tails_table, Tails, FAILED_ERRORS};
-use shapecorr::correspondence::Params;
 use shapecorr::evaluation::score_correspondence;
-use shapecorr::maps::pointwise::{regions_and_map, PointwiseCorrespondence, PointwiseParams};
+use shapecorr::maps::pointwise::PointwiseParams;
+use shapecorr::pipeline::pointwise::regions_and_map;
+use shapecorr::pipeline::Params;
+use shapecorr::pipeline::PointwiseCorrespondence;
 use shapecorr::progress::NoProgress;
 use shapecorr::spectral::eigen::EigenParams;
+use shapecorr::spectral::eigen::ShapeBasis;
 use shapecorr::Result;
 
 /// One pair of the tails run.
@@ -130,8 +133,8 @@ fn tail_pair(
         (result.regions, result.map)
     } else {
         regions_and_map(
-            (a, basis_a),
-            (b, basis_b),
+            ShapeBasis::new(a, basis_a),
+            ShapeBasis::new(b, basis_b),
             params,
             pointwise,
             &mut NoProgress,

@@ -32,13 +32,14 @@
 
 use std::time::Instant;
 
-use shapecorr::correspondence::{one_to_one_matches, Correspondence, Params, Timings};
+use shapecorr::pipeline::{one_to_one_matches, Correspondence, Params, Timings};
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::regions::matching::match_graphs;
 use shapecorr::regions::segmentation::{compare_graphs, Regions};
 use shapecorr::shape::Shape;
 use shapecorr::spectral::descriptors::{hks, HksParams};
 use shapecorr::spectral::eigen::Eigenbasis;
+use shapecorr::spectral::eigen::ShapeBasis;
 use shapecorr::{Error, Result};
 
 /// HKS time of the baseline on the unit-area shape (the crate's HKS convention: absolute
@@ -408,8 +409,8 @@ pub fn reeb_correspondence(
 
     let t = Instant::now();
     let matches_one_to_one = one_to_one_matches(
-        (a, basis_a, &graph_a),
-        (b, basis_b, &graph_b),
+        (ShapeBasis::new(a, basis_a), &graph_a),
+        (ShapeBasis::new(b, basis_b), &graph_b),
         &matching.matches,
         params,
     )?;
@@ -431,5 +432,6 @@ pub fn reeb_correspondence(
         candidates: vec![candidate],
         timings,
         verdict: None,
+        estimate: None,
     })
 }

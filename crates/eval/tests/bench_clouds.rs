@@ -7,8 +7,8 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::score;
+use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::synth::{self, FigureKind, Proportions};
 use shapecorr::ReadAs;
 use shapecorr::{Error, NoProgress, Shape};
@@ -566,10 +566,10 @@ fn faust_pair_quick_check() {
     let params = Params::default();
     let started = std::time::Instant::now();
     let mesh = Correspondence::compute(&a, &b, &params, &mut NoProgress).unwrap();
-    let mass = shapecorr::Eigenbasis::compute(&a, &params.eigen)
+    let mass = shapecorr::Eigenbasis::compute(&a, &params.eigen, &mut NoProgress)
         .unwrap()
         .mass;
-    let mass_b = shapecorr::Eigenbasis::compute(&b, &params.eigen)
+    let mass_b = shapecorr::Eigenbasis::compute(&b, &params.eigen, &mut NoProgress)
         .unwrap()
         .mass;
     let mesh_scores =

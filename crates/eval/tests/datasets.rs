@@ -339,7 +339,7 @@ fn pointwise_bench_keeps_its_eigenbases_in_the_cache() {
         shapecorr_eval::bench_pointwise::bench_pointwise(
             &root,
             &pairs,
-            &shapecorr::correspondence::Params::default(),
+            &shapecorr::pipeline::Params::default(),
             &shapecorr::maps::pointwise::PointwiseParams::default(),
             0,
             Some(&["regions".to_string()]),

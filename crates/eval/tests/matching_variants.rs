@@ -10,9 +10,11 @@ use shapecorr::regions::matching::match_hop_distances;
 use shapecorr::regions::matching::{
     distance_histograms, leading_eigenvector, unary_costs, Affinity, DistanceTerm, MatchingParams,
 };
+use shapecorr::regions::segmentation::Described;
 use shapecorr::regions::segmentation::{segment_pair, SegmentationParams};
 use shapecorr::regions::symmetry::{one_to_one, SymmetryParams};
 use shapecorr::spectral::descriptors::{hks, HksParams};
+use shapecorr::NoProgress;
 use shapecorr::{EigenParams, Eigenbasis, ReadAs, Shape};
 use shapecorr_eval::datasets::{default_data_root, read_pairs, Dataset};
 
@@ -56,13 +58,18 @@ fn measure_variants_on_benchmark_pairs() {
     for pair in &chosen {
         let (a, b) = (prepare(&pair.source), prepare(&pair.target));
         let seg = segment_pair(
-            &a.shape,
-            &a.mass,
-            a.hks.as_ref(),
-            &b.shape,
-            &b.mass,
-            b.hks.as_ref(),
+            Described {
+                shape: &a.shape,
+                mass: &a.mass,
+                descriptors: a.hks.as_ref(),
+            },
+            Described {
+                shape: &b.shape,
+                mass: &b.mass,
+                descriptors: b.hks.as_ref(),
+            },
             &SegmentationParams::default(),
+            &mut NoProgress,
         )
         .unwrap();
         let (ga, gb) = (&seg.graph_a, &seg.graph_b);
@@ -166,7 +173,7 @@ struct Prepared {
 
 fn prepare_shape(dataset: &Dataset, name: &str) -> Prepared {
     let shape = Shape::read(&dataset.shape_path(name).unwrap(), ReadAs::Auto).unwrap();
-    let basis = Eigenbasis::compute(&shape, &EigenParams::default()).unwrap();
+    let basis = Eigenbasis::compute(&shape, &EigenParams::default(), &mut NoProgress).unwrap();
     let hks = hks(&basis, &HksParams::default()).unwrap();
     Prepared {
         mass: basis.mass.clone(),

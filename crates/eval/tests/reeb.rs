@@ -2,10 +2,11 @@
 //! generated figures with known functions, the equal-area levels, and the baseline end to
 //! end through the same matcher and scores as the main method.
 
-use shapecorr::correspondence::Params;
 use shapecorr::evaluation::score_correspondence;
+use shapecorr::pipeline::Params;
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::synth::{self, FigureKind, FigureMesh, FigureSpec};
+use shapecorr::NoProgress;
 use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Error, Shape};
 use shapecorr_eval::reeb::{
@@ -34,6 +35,7 @@ fn basis(shape: &Shape, n: usize) -> Eigenbasis {
             n_eigenpairs: n,
             ..Default::default()
         },
+        &mut NoProgress,
     )
     .unwrap()
 }
@@ -375,8 +377,8 @@ fn the_baseline_runs_end_to_end_through_the_main_matcher() {
     let a = mesh(&rest);
     let posed = mesh(&figure(FigureKind::Humanoid, 2, 3000));
     let params = Params::default();
-    let ba = Eigenbasis::compute(&a, &params.eigen).unwrap();
-    let bb = Eigenbasis::compute(&posed, &params.eigen).unwrap();
+    let ba = Eigenbasis::compute(&a, &params.eigen, &mut NoProgress).unwrap();
+    let bb = Eigenbasis::compute(&posed, &params.eigen, &mut NoProgress).unwrap();
     let reeb = ReebParams::default();
     let truth: Vec<(u32, u32)> = (0..a.n_vertices() as u32).map(|v| (v, v)).collect();
     let flipped: Vec<(u32, u32)> = truth
@@ -553,7 +555,7 @@ fn measure_on_benchmark(dataset: &str, names: &[String], mirror_file: &str) {
     for name in names {
         let path = folder.join(format!("{name}.ply"));
         let shape = Shape::read(&path, ReadAs::Auto).unwrap_or_else(|e| panic!("{e}"));
-        let b = Eigenbasis::compute(&shape, &params.eigen).unwrap();
+        let b = Eigenbasis::compute(&shape, &params.eigen, &mut NoProgress).unwrap();
         for levels in [5, 6, 8, 10] {
             let counts: Vec<usize> = [0.0, 0.002, 0.005]
                 .iter()

@@ -52,7 +52,7 @@ pub fn joint_kmeans_with(
     params: &KMeansParams,
 ) -> JointClustering {
     let points = Points::new(a, mass_a, b, mass_b);
-    kmeans(&points, params)
+    kmeans(&points, params, &Cancel::default()).expect("a default Cancel is never set")
 }
 
 /// The stacked points of both shapes in canonical order.
@@ -254,13 +254,9 @@ fn sample(scores: &[f64], rng: &mut ChaCha8Rng) -> Option<usize> {
     last_positive
 }
 
-pub(super) fn kmeans(points: &Points, params: &KMeansParams) -> JointClustering {
-    kmeans_cancellable(points, params, &Cancel::default()).expect("never cancelled")
-}
-
-/// As [`kmeans`], stopping with [`crate::Error::Cancelled`] between Lloyd iterations once
-/// `cancel` is set.
-pub(super) fn kmeans_cancellable(
+/// Weighted k-means with k-means++ seeding and `params.restarts` restarts (the best kept);
+/// stops with [`crate::Error::Cancelled`] between Lloyd iterations once `cancel` is set.
+pub(super) fn kmeans(
     points: &Points,
     params: &KMeansParams,
     cancel: &Cancel,

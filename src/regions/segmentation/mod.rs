@@ -360,46 +360,17 @@ pub fn rank_align_common(
 /// connected graphs, else among all) the one with the smallest weighted degree-histogram
 /// difference wins ([`degree_histogram_difference`]); ties follow `params.tie_break`.
 ///
-/// `mass_*` are the per-vertex masses (e.g. [`crate::Eigenbasis::mass`]), `desc_*` one
-/// descriptor row per input vertex (e.g. HKS).
+/// Reports progress over the values of k and stops with [`Error::Cancelled`] when
+/// `progress` asks to: the k values run in parallel in batches of the thread count, with a
+/// report (and a chance to cancel) between batches.
 pub fn segment_pair(
-    shape_a: &Shape,
-    mass_a: &[f64],
-    desc_a: MatRef<f64>,
-    shape_b: &Shape,
-    mass_b: &[f64],
-    desc_b: MatRef<f64>,
-    params: &SegmentationParams,
-) -> Result<JointSegmentation> {
-    segment_pair_with_progress(
-        shape_a,
-        mass_a,
-        desc_a,
-        shape_b,
-        mass_b,
-        desc_b,
-        params,
-        &mut crate::progress::NoProgress,
-    )
-}
-
-/// One value of k tried: its scores, both graphs and the centroids.
-type Tried = (KCandidate, ShapeGraph, ShapeGraph, Mat<f64>);
-
-/// As [`segment_pair`], reporting progress over the values of k and stopping with
-/// [`Error::Cancelled`] when `progress` asks to. The k values run in parallel in batches of
-/// the thread count, with a report (and a chance to cancel) between batches.
-#[allow(clippy::too_many_arguments)]
-pub fn segment_pair_with_progress(
-    shape_a: &Shape,
-    mass_a: &[f64],
-    desc_a: MatRef<f64>,
-    shape_b: &Shape,
-    mass_b: &[f64],
-    desc_b: MatRef<f64>,
+    a: Described<'_>,
+    b: Described<'_>,
     params: &SegmentationParams,
     progress: &mut dyn crate::progress::Progress,
 ) -> Result<JointSegmentation> {
+    let (shape_a, mass_a, desc_a) = (a.shape, a.mass, a.descriptors);
+    let (shape_b, mass_b, desc_b) = (b.shape, b.mass, b.descriptors);
     params.validate()?;
     validate_inputs("a", shape_a, mass_a, desc_a)?;
     validate_inputs("b", shape_b, mass_b, desc_b)?;
@@ -452,7 +423,7 @@ pub fn segment_pair_with_progress(
                     metric: params.metric,
                     max_iterations: params.kmeans_max_iterations,
                 };
-                let clustering = kmeans::kmeans_cancellable(&points, &kmeans_params, cancel)?;
+                let clustering = kmeans::kmeans(&points, &kmeans_params, cancel)?;
                 let centroids = clustering.centroids.as_ref();
                 let (graph_a, graph_b) = rayon::join(
                     || {
@@ -506,6 +477,19 @@ pub fn segment_pair_with_progress(
         candidates,
     })
 }
+/// One shape as the joint segmentation reads it.
+#[derive(Debug, Clone, Copy)]
+pub struct Described<'a> {
+    /// The shape (its edges or neighbour graph make the regions connected).
+    pub shape: &'a Shape,
+    /// Per-vertex masses (e.g. [`crate::Eigenbasis::mass`]).
+    pub mass: &'a [f64],
+    /// One descriptor row per input vertex (e.g. HKS).
+    pub descriptors: MatRef<'a, f64>,
+}
+
+/// One value of k tried: its scores, both graphs and the centroids.
+type Tried = (KCandidate, ShapeGraph, ShapeGraph, Mat<f64>);
 
 fn validate_inputs(
     which: &'static str,

@@ -4,11 +4,12 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use shapecorr::correspondence::{Correspondence, Params};
 use shapecorr::evaluation::score_correspondence;
-use shapecorr::maps::pointwise::{truncated, PointwiseMap, PointwiseParams};
+use shapecorr::maps::pointwise::{PointwiseMap, PointwiseParams};
+use shapecorr::pipeline::pointwise::truncated;
+use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
-use shapecorr::{EigenParams, Eigenbasis, Error, Shape};
+use shapecorr::{EigenParams, Eigenbasis, Error, NoProgress, Shape, ShapeBasis};
 
 use crate::output::{
     correspondence_json, create_dir, end_progress_line, write_colored, write_json, write_map,
@@ -55,15 +56,13 @@ impl DemoArgs {
             n_eigenpairs: pointwise.n_eigenpairs,
             ..params.eigen.clone()
         };
-        let full_a = Eigenbasis::compute(&a, &eigen)?;
-        let full_b = Eigenbasis::compute(&b, &eigen)?;
+        let full_a = Eigenbasis::compute(&a, &eigen, &mut NoProgress)?;
+        let full_b = Eigenbasis::compute(&b, &eigen, &mut NoProgress)?;
         let basis_a = truncated(&full_a, params.eigen.n_eigenpairs);
         let basis_b = truncated(&full_b, params.eigen.n_eigenpairs);
         let result = Correspondence::from_bases(
-            &a,
-            &basis_a,
-            &b,
-            &basis_b,
+            ShapeBasis::new(&a, &basis_a),
+            ShapeBasis::new(&b, &basis_b),
             &params,
             &mut TerminalProgress::new(),
         );
@@ -114,7 +113,13 @@ impl DemoArgs {
             scores.unmatched
         );
         // Point-to-point map from the regions (functional map + ZoomOut).
-        let map = PointwiseMap::from_bases(&a, &full_a, &b, &full_b, Some(&result), &pointwise)?;
+        let map = PointwiseMap::from_bases(
+            ShapeBasis::new(&a, &full_a),
+            ShapeBasis::new(&b, &full_b),
+            Some(result.matches_view()),
+            &pointwise,
+            &mut NoProgress,
+        )?;
         write_map(&out.join("map_b_to_a.txt"), &map.p2p_ba)?;
         write_map_colors(out, &a, &b, &map.p2p_ba)?;
         report_map(&a, &full_a, &map, &truth, &flipped)?;

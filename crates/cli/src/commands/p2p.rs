@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use serde_json::json;
-use shapecorr::maps::pointwise::PointwiseCorrespondence;
 use shapecorr::Error;
+use shapecorr::PointwiseCorrespondence;
 
 use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
@@ -53,8 +53,7 @@ impl P2pArgs {
         value["fmap_size"] = json!(result.map.fmap_ab.nrows());
         value["options"] = options_json(&options, true);
         value["region_times"] = json!(pointwise.region_times);
-        let job = PointwiseCorrespondence::job(&shape_a, &shape_b, &options.params, &pointwise);
-        value["budget"] = budget_json(&job);
+        value["budget"] = budget_json(&result.estimate);
         // The answer's verdict: the map's own when it verified hypotheses, else the regions'.
         set_verdict_json(&mut value, result.verdict());
         write_json(&out.join("result.json"), &value)?;

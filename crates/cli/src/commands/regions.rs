@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use serde_json::json;
-use shapecorr::correspondence::{Correspondence, Symmetry};
+use shapecorr::pipeline::{Correspondence, Symmetry};
 use shapecorr::Error;
 
 use crate::input::{read_input, ShapePairArgs};
@@ -41,7 +41,9 @@ impl MatchArgs {
         let result = result.map_err(|e| self.pair.naming(e))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
         value["options"] = options_json(&options, false);
-        value["budget"] = budget_json(&Correspondence::job(&shape_a, &shape_b, &options.params));
+        if let Some(estimate) = &result.estimate {
+            value["budget"] = budget_json(estimate);
+        }
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result)?;
         println!(

@@ -4,10 +4,10 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use shapecorr::maps::pointwise::PointwiseCorrespondence;
 use shapecorr::maps::surface::SurfaceMap;
 use shapecorr::transfer::TransferMode;
 use shapecorr::Error;
+use shapecorr::PointwiseCorrespondence;
 
 use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
@@ -62,12 +62,8 @@ impl TransferArgs {
             &mut progress,
         )
         .and_then(|result| {
-            let onto = SurfaceMap::from_vertex_map_with_progress(
-                &shape_a,
-                &shape_b,
-                &result.map.p2p_ba,
-                &mut progress,
-            )?;
+            let onto =
+                SurfaceMap::from_vertex_map(&shape_a, &shape_b, &result.map.p2p_ba, &mut progress)?;
             Ok((result, onto))
         });
         end_progress_line();

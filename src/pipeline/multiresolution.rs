@@ -15,11 +15,11 @@
 
 use rayon::prelude::*;
 
-use crate::correspondence::Correspondence;
+use crate::pipeline::correspondence::Correspondence;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::neighbors::PointTree;
 use crate::shape::proxy::Proxy;
-use crate::shape::Shape;
+use crate::shape::{distance, Shape};
 use crate::spectral::eigen::{check_max_vertices, EigenParams};
 use crate::Result;
 
@@ -145,8 +145,8 @@ const TEAR_EDGES: f64 = 3.0;
 /// vertex of the working shape) brought to every input vertex of B, as input vertices of
 /// A. See the module docs.
 pub(crate) fn lift_map(
-    (a, proxy_a): (&Shape, &Option<Proxy>),
-    (b, proxy_b): (&Shape, &Option<Proxy>),
+    (a, proxy_a): (&Shape, Option<&Proxy>),
+    (b, proxy_b): (&Shape, Option<&Proxy>),
     p2p_ba: &[u32],
     progress: &mut dyn Progress,
 ) -> Result<Vec<u32>> {
@@ -154,19 +154,20 @@ pub(crate) fn lift_map(
         return Ok(p2p_ba.to_vec());
     }
     polled(progress, Stage::Proxy, (0.5, 1.0), |cancel| {
-        lift_map_cancellable((a, proxy_a), (b, proxy_b), p2p_ba, cancel)
+        lift_map_polling((a, proxy_a), (b, proxy_b), p2p_ba, cancel)
     })
 }
 
-fn lift_map_cancellable(
-    (a, proxy_a): (&Shape, &Option<Proxy>),
-    (b, proxy_b): (&Shape, &Option<Proxy>),
+/// [`lift_map`] on the calling thread, polling `cancel` between blocks.
+fn lift_map_polling(
+    (a, proxy_a): (&Shape, Option<&Proxy>),
+    (b, proxy_b): (&Shape, Option<&Proxy>),
     p2p_ba: &[u32],
     cancel: &Cancel,
 ) -> Result<Vec<u32>> {
-    let working_a = working(a, proxy_a);
+    let working_a = proxy_a.map_or(a, |p| &p.shape);
     // A proxy vertex of A as an input vertex of A.
-    let input_a = |v: u32| proxy_a.as_ref().map_or(v, |p| p.input_vertex[v as usize]);
+    let input_a = |v: u32| proxy_a.map_or(v, |p| p.input_vertex[v as usize]);
     let active_a = a.active_vertices();
     let tree = PointTree::new(
         &active_a
@@ -174,7 +175,7 @@ fn lift_map_cancellable(
             .map(|&v| a.vertices()[v as usize])
             .collect::<Vec<_>>(),
     );
-    let tear = TEAR_EDGES * mean_edge_length(working_a);
+    let tear = TEAR_EDGES * working_a.mean_edge_length();
     let n_b = b.n_vertices();
     let mut out = Vec::with_capacity(n_b);
     for start in (0..n_b).step_by(LIFT_BLOCK) {
@@ -209,37 +210,4 @@ fn lift_map_cancellable(
         out.extend(block);
     }
     Ok(out)
-}
-
-fn distance(p: &[f64; 3], q: &[f64; 3]) -> f64 {
-    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-}
-
-/// Mean edge length of a mesh; for a point cloud, the mean distance to the nearest other
-/// point.
-pub(crate) fn mean_edge_length(shape: &Shape) -> f64 {
-    let p = shape.vertices();
-    let edges = shape.edges();
-    if !edges.is_empty() {
-        return edges
-            .iter()
-            .map(|&(i, j)| distance(&p[i as usize], &p[j as usize]))
-            .sum::<f64>()
-            / edges.len() as f64;
-    }
-    let active: Vec<[f64; 3]> = shape
-        .active_vertices()
-        .iter()
-        .map(|&v| p[v as usize])
-        .collect();
-    let tree = PointTree::new(&active);
-    active
-        .iter()
-        .map(|q| {
-            tree.nearest_k(q, 2)
-                .last()
-                .map_or(0.0, |&(_, d2)| d2.sqrt())
-        })
-        .sum::<f64>()
-        / active.len() as f64
 }

@@ -152,21 +152,13 @@ pub fn estimate(job: &Job) -> Estimate {
     }
 }
 
-/// The memory the system can give now (`MemAvailable`), where it says (Linux).
-pub fn available_bytes() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_ascii_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
 impl Budget {
     /// The memory ceiling in bytes: the configured one, or what the system has available.
     pub fn memory_limit_bytes(&self) -> Option<u64> {
         if self.memory_limit_mib > 0 {
             Some(self.memory_limit_mib.saturating_mul(1 << 20))
         } else {
-            available_bytes()
+            crate::system::available_bytes()
         }
     }
 

@@ -1,0 +1,272 @@
+//! The pair job, written once (docs/design.md, "The whole job"): the parameters checked,
+//! the job's memory and time estimated and held to the budget, dense shapes replaced by
+//! their proxies, the eigenbases computed (or taken from a collection's prepared shapes),
+//! the regions and, when asked, the point-to-point map, and the answers brought back to
+//! every input vertex. `match`, `p2p`, symmetry detection and every pair of a batch run
+//! through [`run_pair`].
+
+use std::time::Instant;
+
+use crate::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement};
+use crate::pipeline::budget::{regions_job, Estimate, Job};
+use crate::pipeline::correspondence::Correspondence;
+use crate::pipeline::multiresolution::{lift_map, lift_regions, working};
+use crate::pipeline::pointwise::{basis_params, regions_and_map};
+use crate::pipeline::Params;
+use crate::progress::Progress;
+use crate::shape::proxy::Proxy;
+use crate::shape::Shape;
+use crate::spectral::eigen::{check_max_vertices, EigenParams, Eigenbasis, ShapeBasis};
+use crate::Result;
+
+/// What a pair job computes and with which parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct PairJob<'a> {
+    /// The method's parameters (regions, budget, proxies).
+    pub params: &'a Params,
+    /// The point-to-point map's parameters; `None` computes the regions only.
+    pub map: Option<&'a PointwiseParams>,
+}
+
+/// A shape with its per-shape work done: its proxy when it is dense and the eigenbasis of
+/// the shape the pipeline runs on (the proxy, or the shape itself).
+#[derive(Debug, Clone, Copy)]
+pub struct ReadyShape<'a> {
+    /// The shape as given.
+    pub shape: &'a Shape,
+    /// Its proxy ([`crate::pipeline::multiresolution`]).
+    pub proxy: Option<&'a Proxy>,
+    /// The eigenbasis of the working shape, with [`PairJob::eigen_params`]'s eigenpairs.
+    pub basis: &'a Eigenbasis,
+}
+
+impl<'a> ReadyShape<'a> {
+    /// The shape the pipeline runs on: the proxy, or the shape itself.
+    pub fn working(&self) -> &'a Shape {
+        self.proxy.map_or(self.shape, |p| &p.shape)
+    }
+}
+
+/// The shapes of a pair job.
+#[derive(Debug, Clone, Copy)]
+pub enum PairShapes<'a> {
+    /// Two shapes: their proxies and eigenbases are computed here.
+    Two(&'a Shape, &'a Shape),
+    /// One shape matched to itself (symmetry detection): one proxy and one eigenbasis.
+    Itself(&'a Shape),
+    /// Two shapes prepared beforehand (a collection's cache): nothing per shape is computed.
+    Ready(ReadyShape<'a>, ReadyShape<'a>),
+}
+
+/// What a pair job gives.
+#[derive(Debug, Clone)]
+pub struct PairResult {
+    /// The region correspondence, on every input vertex.
+    pub regions: Correspondence,
+    /// The map from B to A on every input vertex, when [`PairJob::map`] asked for it.
+    pub map: Option<PointwiseMap>,
+    /// The estimate the budget accepted.
+    pub estimate: Estimate,
+    /// Seconds of A's and B's eigenbases (0 for shapes prepared beforehand).
+    pub eigenbasis_s: [f64; 2],
+    /// Seconds of building the proxies and bringing the answers back to every input vertex.
+    pub proxies_s: f64,
+    /// Seconds of the whole job.
+    pub total_s: f64,
+}
+
+impl PairJob<'_> {
+    /// Checks every parameter's range.
+    pub fn validate(&self) -> Result<()> {
+        self.params.validate()?;
+        self.map.map_or(Ok(()), |m| m.validate())
+    }
+
+    /// The eigensolver's parameters: the regions' eigenpairs, or the map's when it has more.
+    pub fn eigen_params(&self) -> EigenParams {
+        match self.map {
+            Some(map) => basis_params(self.params, map),
+            None => self.params.eigen.clone(),
+        }
+    }
+
+    /// The job's work on shapes of these sizes (active vertices), for the budget: the
+    /// regions' eigensolves and the full-resolution conversions of maps (up to three when
+    /// the hypotheses are verified: the answer and a close call's rival).
+    pub fn budget_job(&self, [a, b]: [&Shape; 2]) -> Job {
+        let sizes = [a, b].map(|s| self.params.multiresolution.working_size(s));
+        let params = self.params;
+        match self.map {
+            None => {
+                let verify = params.verify_hypotheses && !params.skip_one_to_one;
+                regions_job(sizes, &params.eigen, verify)
+            }
+            Some(map) => {
+                let eigen = self.eigen_params();
+                let size = match &map.refinement {
+                    Refinement::ZoomOut(z) => z.k_end,
+                    _ => map.fmap_size,
+                };
+                Job {
+                    conversions: if params.verify_hypotheses { 3 } else { 1 },
+                    conversion_size: size.min(eigen.n_eigenpairs),
+                    ..regions_job(sizes, &eigen, false)
+                }
+            }
+        }
+    }
+}
+
+/// The pair job: see the module docs. A job the budget refuses fails before any work; the
+/// time limit stops it while it runs.
+pub fn run_pair(
+    shapes: PairShapes<'_>,
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<PairResult> {
+    job.validate()?;
+    let [a, b] = match shapes {
+        PairShapes::Two(a, b) => [a, b],
+        PairShapes::Itself(a) => [a, a],
+        PairShapes::Ready(a, b) => [a.shape, b.shape],
+    };
+    let estimate = job.params.budget.check(&job.budget_job([a, b]))?;
+    job.params.budget.run(progress, |progress| {
+        let started = Instant::now();
+        let mut result = match shapes {
+            PairShapes::Ready(a, b) => on_ready(a, b, job, progress)?,
+            PairShapes::Two(a, b) => prepare_and_run([a, b], job, progress)?,
+            PairShapes::Itself(a) => prepare_itself_and_run(a, job, progress)?,
+        };
+        result.estimate = estimate;
+        result.total_s = started.elapsed().as_secs_f64();
+        result.regions.timings.total = result.total_s;
+        result.regions.estimate = Some(estimate);
+        Ok(result)
+    })
+}
+
+/// Two shapes: proxies, both eigenbases (side by side when small), then the pair.
+fn prepare_and_run(
+    [a, b]: [&Shape; 2],
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<PairResult> {
+    let eigen = job.eigen_params();
+    let started = Instant::now();
+    let [proxy_a, proxy_b] = job
+        .params
+        .multiresolution
+        .proxies([a, b], &eigen, progress)?;
+    let built = started.elapsed().as_secs_f64();
+    let working_pair = (working(a, &proxy_a), working(b, &proxy_b));
+    let ([basis_a, basis_b], eigenbasis_s) = Eigenbasis::pair(working_pair, &eigen, progress)?;
+    let ready_a = ReadyShape {
+        shape: a,
+        proxy: proxy_a.as_ref(),
+        basis: &basis_a,
+    };
+    let ready_b = ReadyShape {
+        shape: b,
+        proxy: proxy_b.as_ref(),
+        basis: &basis_b,
+    };
+    let mut result = on_ready(ready_a, ready_b, job, progress)?;
+    result.eigenbasis_s = eigenbasis_s;
+    [
+        result.regions.timings.eigenbasis_a,
+        result.regions.timings.eigenbasis_b,
+    ] = eigenbasis_s;
+    add_proxy_time(&mut result, built, [&proxy_a, &proxy_b]);
+    Ok(result)
+}
+
+/// One shape matched to itself: one proxy and one eigenbasis, used on both sides (the
+/// descriptors are then computed once too).
+fn prepare_itself_and_run(
+    shape: &Shape,
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<PairResult> {
+    let eigen = job.eigen_params();
+    let started = Instant::now();
+    check_max_vertices(shape, &eigen)?;
+    let proxy = job.params.multiresolution.proxy(shape)?;
+    let built = started.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let basis = Eigenbasis::compute(working(shape, &proxy), &eigen, progress)?;
+    let eigenbasis_s = t.elapsed().as_secs_f64();
+    let ready = ReadyShape {
+        shape,
+        proxy: proxy.as_ref(),
+        basis: &basis,
+    };
+    let mut result = on_ready(ready, ready, job, progress)?;
+    result.eigenbasis_s = [eigenbasis_s, 0.0];
+    result.regions.timings.eigenbasis_a = eigenbasis_s;
+    add_proxy_time(&mut result, built, [&proxy, &None]);
+    Ok(result)
+}
+
+/// Adds the proxies' building time to the lifting time already counted, when there are
+/// proxies.
+fn add_proxy_time(result: &mut PairResult, built: f64, proxies: [&Option<Proxy>; 2]) {
+    if proxies.iter().any(|p| p.is_some()) {
+        result.proxies_s += built;
+        result.regions.timings.proxies = result.proxies_s;
+    }
+}
+
+/// The pair on prepared shapes: the regions (verified by maps on the regions' bases,
+/// [`Correspondence::from_bases`]), or
+/// the regions and the map (verified once, by the map), then the answers on every input
+/// vertex.
+fn on_ready(
+    a: ReadyShape<'_>,
+    b: ReadyShape<'_>,
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<PairResult> {
+    let (working_a, working_b) = (
+        ShapeBasis::new(a.working(), a.basis),
+        ShapeBasis::new(b.working(), b.basis),
+    );
+    let (mut regions, mut map) = match job.map {
+        Some(pointwise) => {
+            let (regions, map) =
+                regions_and_map(working_a, working_b, job.params, pointwise, progress)?;
+            (regions, Some(map))
+        }
+        None => (
+            Correspondence::from_bases(working_a, working_b, job.params, progress)?,
+            None,
+        ),
+    };
+    let t = Instant::now();
+    lift_regions(&mut regions, [a.proxy, b.proxy]);
+    if let Some(map) = &mut map {
+        map.p2p_ba = lift_map(
+            (a.shape, a.proxy),
+            (b.shape, b.proxy),
+            &map.p2p_ba,
+            progress,
+        )?;
+    }
+    let proxies_s = if a.proxy.is_some() || b.proxy.is_some() {
+        t.elapsed().as_secs_f64()
+    } else {
+        0.0
+    };
+    regions.timings.proxies = proxies_s;
+    Ok(PairResult {
+        regions,
+        map,
+        estimate: Estimate {
+            bytes: 0,
+            seconds: 0.0,
+        },
+        eigenbasis_s: [0.0; 2],
+        proxies_s,
+        total_s: 0.0,
+    })
+}

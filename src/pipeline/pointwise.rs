@@ -1,0 +1,176 @@
+//! The pointwise job: the regions and the point-to-point map of a pair on given eigenbases
+//! (docs/design.md, step 13), and the verification of a region answer by maps (step 12.1).
+
+use crate::maps::fmap::ZoomOutParams;
+use crate::maps::hypotheses::{self, Verdict};
+use crate::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement};
+use crate::pipeline::budget::Estimate;
+use crate::pipeline::correspondence::Correspondence;
+use crate::pipeline::pair::{run_pair, PairJob, PairShapes};
+use crate::pipeline::Params;
+use crate::progress::{check, AsStage, Progress, Stage};
+use crate::shape::Shape;
+use crate::spectral::eigen::{EigenParams, Eigenbasis, ShapeBasis};
+use crate::Result;
+
+/// Everything from two shapes: eigenbases, region correspondence, pointwise map.
+#[derive(Debug, Clone)]
+pub struct PointwiseCorrespondence {
+    /// The region correspondence the map is built on.
+    pub regions: Correspondence,
+    /// The point-to-point map from B to A.
+    pub map: PointwiseMap,
+    /// Seconds of A's eigenbasis.
+    pub eigenbasis_a: f64,
+    /// Seconds of B's eigenbasis.
+    pub eigenbasis_b: f64,
+    /// Seconds of building the proxies of dense shapes and bringing the regions and the map
+    /// back to every input vertex (0 at full resolution, [`Params::multiresolution`]).
+    pub proxies: f64,
+    /// Seconds of the whole call.
+    pub total: f64,
+    /// What the job was estimated to take before it started ([`crate::pipeline::budget`]).
+    pub estimate: Estimate,
+}
+
+impl PointwiseCorrespondence {
+    /// Region correspondence and pointwise map of two shapes. Each eigenbasis is computed
+    /// once, with `pointwise.n_eigenpairs` pairs; region matching uses its first
+    /// `params.eigen.n_eigenpairs`.
+    pub fn compute(
+        a: &Shape,
+        b: &Shape,
+        params: &Params,
+        pointwise: &PointwiseParams,
+        progress: &mut dyn Progress,
+    ) -> Result<PointwiseCorrespondence> {
+        let job = PairJob {
+            params,
+            map: Some(pointwise),
+        };
+        let pair = run_pair(PairShapes::Two(a, b), job, progress)?;
+        let map = pair
+            .map
+            .expect("a pair job with map parameters gives a map");
+        Ok(PointwiseCorrespondence {
+            regions: pair.regions,
+            map,
+            eigenbasis_a: pair.eigenbasis_s[0],
+            eigenbasis_b: pair.eigenbasis_s[1],
+            proxies: pair.proxies_s,
+            total: pair.total_s,
+            estimate: pair.estimate,
+        })
+    }
+
+    /// The verdict behind the answer: the map's own when it verified hypotheses, else the
+    /// regions'.
+    pub fn verdict(&self) -> Option<&Verdict> {
+        self.map.verdict.as_ref().or(self.regions.verdict.as_ref())
+    }
+
+    /// The confidence of the answer in [0, 1] ([`PointwiseCorrespondence::verdict`]; None
+    /// when nothing was verified).
+    pub fn confidence(&self) -> Option<f64> {
+        self.verdict().map(|v| v.confidence)
+    }
+}
+
+/// The eigensolver's parameters of a pointwise job: enough eigenpairs for the map and the
+/// regions, computed once per shape.
+pub fn basis_params(params: &Params, pointwise: &PointwiseParams) -> EigenParams {
+    EigenParams {
+        n_eigenpairs: pointwise.n_eigenpairs.max(params.eigen.n_eigenpairs),
+        ..params.eigen.clone()
+    }
+}
+
+/// The regions (on the first `params.eigen.n_eigenpairs` of the bases) and the map (on all of
+/// them). With `params.verify_hypotheses`, the hypotheses are verified once, by the map on
+/// its larger basis (on FAUST_r, verifying on the regions' 50 eigenpairs failed 15 of 126
+/// pairs, on the map's 100 one: docs/tails.md), and the regions follow the chosen map
+/// ([`hypotheses::one_to_one_from_map`]) and carry its verdict.
+pub fn regions_and_map(
+    a: ShapeBasis<'_>,
+    b: ShapeBasis<'_>,
+    params: &Params,
+    pointwise: &PointwiseParams,
+    progress: &mut dyn Progress,
+) -> Result<(Correspondence, PointwiseMap)> {
+    let k = params.eigen.n_eigenpairs;
+    let unverified = Params {
+        verify_hypotheses: false,
+        ..params.clone()
+    };
+    let (basis_a, basis_b) = (truncated(a.basis, k), truncated(b.basis, k));
+    let mut regions = Correspondence::from_bases(
+        ShapeBasis::new(a.shape, &basis_a),
+        ShapeBasis::new(b.shape, &basis_b),
+        &unverified,
+        progress,
+    )?;
+    check(progress, Stage::PointwiseMap, 0.0)?;
+    let pointwise = PointwiseParams {
+        hypotheses: pointwise.hypotheses && params.verify_hypotheses,
+        orientation: pointwise.orientation && params.verify_hypotheses,
+        ..pointwise.clone()
+    };
+    let map = PointwiseMap::from_bases(a, b, Some(regions.matches_view()), &pointwise, progress)?;
+    if let Some(verdict) = &map.verdict {
+        regions.matches_one_to_one =
+            hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);
+        regions.verdict = Some(verdict.clone());
+    }
+    check(progress, Stage::PointwiseMap, 1.0)?;
+    Ok((regions, map))
+}
+
+/// Verifies the one-to-one answer of `regions` at the map level on the regions' own
+/// eigenbases (ZoomOut up to their size): the hypotheses of [`hypotheses::candidates`] are
+/// refined and judged, the one-to-one matches become those that agree best with the chosen
+/// map ([`hypotheses::one_to_one_from_map`]) and the verdict is kept with them. Nothing
+/// changes when there is a single hypothesis. Reported as [`Stage::SymmetryBreaking`].
+pub fn verify_regions(
+    a: ShapeBasis<'_>,
+    b: ShapeBasis<'_>,
+    regions: &mut Correspondence,
+    progress: &mut dyn Progress,
+) -> Result<()> {
+    if regions.matches_one_to_one.is_empty() {
+        return Ok(());
+    }
+    let n = a.basis.len().min(b.basis.len());
+    let defaults = PointwiseParams::default();
+    let params = PointwiseParams {
+        n_eigenpairs: n,
+        fmap_size: defaults.fmap_size.min(n),
+        refinement: Refinement::ZoomOut(ZoomOutParams {
+            k_end: n,
+            ..Default::default()
+        }),
+        ..defaults
+    };
+    let mut as_stage = AsStage {
+        inner: progress,
+        stage: Stage::SymmetryBreaking,
+    };
+    let map = PointwiseMap::from_bases(a, b, Some(regions.matches_view()), &params, &mut as_stage)?;
+    if let Some(verdict) = map.verdict {
+        regions.matches_one_to_one =
+            hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);
+        regions.verdict = Some(verdict);
+    }
+    Ok(())
+}
+
+/// The first `k` eigenpairs of a basis (a copy; the eigenvectors of a larger solve agree
+/// with a smaller one's to round-off).
+pub fn truncated(basis: &Eigenbasis, k: usize) -> Eigenbasis {
+    let k = k.min(basis.len());
+    Eigenbasis {
+        values: basis.values[..k].to_vec(),
+        vectors: basis.vectors.subcols(0, k).to_owned(),
+        mass: basis.mass.clone(),
+        input_area: basis.input_area,
+    }
+}
