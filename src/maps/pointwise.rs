@@ -223,7 +223,8 @@ impl PointwiseMap {
 
     /// As [`PointwiseMap::from_bases`], reporting progress to `progress` as `stage` (from
     /// the caller's thread, every [`crate::progress::POLL_INTERVAL`]) and stopping within a
-    /// fraction of a second when it cancels: every loop inside checks the cancel (issue 19).
+    /// fraction of a second when it cancels: every loop inside checks the cancel
+    /// (docs/decisions.md, "Cancellation within 0.2 s").
     pub fn from_bases_with_progress(
         (a, basis_a): (&Shape, &Eigenbasis),
         (b, basis_b): (&Shape, &Eigenbasis),
