@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The code stays easy to see: no Rust module over MAX_MODULE_LINES lines and no function
-over MAX_FUNCTION_LINES lines (issue 17), in the pipeline (src/) and the workspace crates
+over MAX_FUNCTION_LINES lines, in the pipeline (src/) and the workspace crates
 (crates/). Tests (`tests.rs`, files under tests/) count too: they are read as often as the code.
 
     python3 tests/layout/check.py [--list]     # exit 1 and one line per offender

@@ -1,4 +1,4 @@
-//! Every pair of every dataset, judged by its tails (`shapecorr bench tails`, issue 18): the
+//! Every pair of every dataset, judged by its tails (`shapecorr bench tails`; docs/tails.md): the
 //! default pipeline (regions verified at the map level, then the map) on each pair, with the
 //! region accuracies, the map's mean geodesic error (no flip: every input here is a mesh,
 //! whose orientation is known), the confidence and the seconds. The page lists per dataset
