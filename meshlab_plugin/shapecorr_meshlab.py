@@ -25,7 +25,7 @@ option, named as the option with ``-`` for ``_`` (``--k-min 5``, ``--gap-ratio 0
 ``--one-to-one false``), plus ``--set NAME=VALUE`` (repeatable, the table's spelling,
 applied after them).
 
-Transfer (issue 21) carries A's vertex colours, quality and per-vertex texture coordinates
+Transfer (docs/transfer.md) carries A's vertex colours, quality and per-vertex texture coordinates
 to B through the correspondence, whatever their poses and bodies::
 
     python meshlab_plugin/shapecorr_meshlab.py transfer A.ply B.ply --out B_from_A.ply

@@ -100,7 +100,8 @@ impl Cancel {
 }
 
 /// How often [`polled`] reports while the work runs: a cancel is seen within this time (plus
-/// the work's own polling interval). Issue 19 asks for 0.2 s.
+/// the work's own polling interval). The target is 0.2 s (docs/decisions.md, "Cancellation
+/// within 0.2 s").
 pub(crate) const POLL_INTERVAL: std::time::Duration = std::time::Duration::from_millis(25);
 
 /// Runs `work` on a helper thread (in a rayon pool of the caller's size) while the caller's

@@ -323,7 +323,7 @@ fn cancelling_inside_the_k_loop_stops_the_segmentation() {
         Correspondence::compute(&a, &b, &Params::default(), &mut progress)
     });
     assert!(matches!(result, Err(Error::Cancelled)));
-    // Reports while the first batch of k values runs (every 25 ms, issue 19), then the
+    // Reports while the first batch of k values runs (every 25 ms, docs/decisions.md, "Cancellation within 0.2 s"), then the
     // first report past it cancels; nothing after the cancel.
     let cancelled_at = reports
         .iter()

@@ -1,4 +1,4 @@
-//! Issue 19, item 21: results do not depend on the number of threads, to the last bit.
+//! Results do not depend on the number of threads, to the last bit.
 
 use shapecorr::options::Options;
 use shapecorr::spectral::descriptors::{hks, HksParams};

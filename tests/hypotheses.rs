@@ -1,4 +1,4 @@
-//! Region hypotheses verified at the map level (issue 18) on generated figures, whose ground
+//! Region hypotheses verified at the map level (docs/design.md, 12.1) on generated figures, whose ground
 //! truth is exact (one vertex order across poses and proportions): a mirrored one-to-one
 //! answer never becomes a mixed map, hard pairs keep their parts, both directions agree,
 //! and every verified answer carries a confidence.

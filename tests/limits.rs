@@ -1,4 +1,5 @@
-//! Never kill or hang the host (issue 19): every option has a range checked before any
+//! Never kill or hang the host (docs/decisions.md, "Option ranges", "Size limits",
+//! "Budget"): every option has a range checked before any
 //! work, a huge but accepted value is cancellable within a fraction of a second, and a
 //! shape above `max_vertices` is refused at once, as is a job over its memory ceiling or
 //! time limit.
@@ -130,7 +131,7 @@ fn every_option_at_its_largest_value_ends_cleanly_and_cancels() {
     }
 }
 
-/// Issue 19, item 7: `kmeans_restarts` at its largest kept running 100 s after a cancel.
+/// `kmeans_restarts` at its largest kept running 100 s after a cancel.
 #[test]
 fn huge_kmeans_restarts_is_cancelled_within_a_fraction_of_a_second() {
     let a = humanoid(0, 3000);
@@ -190,7 +191,7 @@ fn threads_above_the_cores_are_clamped() {
     assert_eq!(effective_threads(1_000_000_000_000), cores);
 }
 
-/// Issue 19, item 17: an error about one shape of a pair says which.
+/// An error about one shape of a pair says which.
 #[test]
 fn an_error_about_one_shape_of_a_pair_names_it() {
     let a = humanoid(0, 700);
@@ -213,7 +214,7 @@ fn an_error_about_one_shape_of_a_pair_names_it() {
     assert!(err.to_string().starts_with("shape B: "), "{err}");
 }
 
-/// Issue 19, item 18: a valid shape scaled by 1e-100 (its area, 1e-200, is representable
+/// A valid shape scaled by 1e-100 (its area, 1e-200, is representable
 /// but its squared lengths are not) gives the same Laplacian and the same regions.
 #[test]
 fn a_shape_scaled_by_1e_minus_100_gives_the_same_answer() {
@@ -321,7 +322,7 @@ fn a_job_started_from_the_only_global_pool_worker_finishes() {
     panic!("the job deadlocked with one global thread");
 }
 
-/// Issue 19, item 4: the pointwise map (its functional maps, ZoomOut, the hypotheses'
+/// The pointwise map (its functional maps, ZoomOut, the hypotheses'
 /// verification and the full-resolution conversions) honours a cancel inside itself. With
 /// 300 eigenpairs, ZoomOut to 300 and a heavy commutativity term it runs for seconds; it
 /// stopped 0.9 s after a cancel when it checked only between stages.
@@ -357,10 +358,10 @@ fn the_pointwise_map_is_cancelled_within_a_fraction_of_a_second() {
     }
 }
 
-/// Issue 19, "done when": a 2M-vertex `match` either finishes within the budget or is
+/// A 2M-vertex `match` either finishes within the budget or is
 /// refused at once with the reason. At full resolution (`proxy_above` 0) the default budget
 /// refuses it before any work (its vertex maps alone are about 4e14 products), naming the
-/// limit and what to do; by default (on proxies, issue 20) `max_vertices` refuses it.
+/// limit and what to do; by default (on proxies, docs/design.md, step 16) `max_vertices` refuses it.
 #[test]
 fn a_two_million_vertex_pair_is_refused_at_once_by_the_default_budget() {
     // A 1415 x 1415 grid of points: 2,002,225 vertices.

@@ -1,4 +1,4 @@
-//! Issue 20: dense shapes run on proxies; the regions and the map come back to every input
+//! Dense shapes run on proxies (docs/design.md, step 16); the regions and the map come back to every input
 //! vertex, clean and as accurate as at full resolution.
 
 use shapecorr::pipeline::multiresolution::Multiresolution;

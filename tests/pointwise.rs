@@ -1,4 +1,4 @@
-//! Functional maps and point-to-point maps (issue 6) on generated shapes with known ground
+//! Functional maps and point-to-point maps (docs/design.md, step 13) on generated shapes with known ground
 //! truth: conversions round-trip on the identity, an isometric copy with permuted vertices
 //! is mapped back, two poses of one figure are mapped with a small geodesic error, and the
 //! result does not depend on the thread count.
@@ -184,7 +184,7 @@ fn zoomout_repairs_a_perturbed_identity_map() {
     );
 }
 
-/// The issue's test: an isometric copy with permuted vertices is mapped back with mean
+/// The acceptance test: an isometric copy with permuted vertices is mapped back with mean
 /// geodesic error below 0.01 (unit-area shape), through the whole pipeline.
 #[test]
 fn permuted_isometric_copy_is_mapped_back() {

@@ -1,4 +1,4 @@
-//! What real files contain (issue 19, `../shared/reliability` items 10-16), made from a
+//! What real files contain (docs/decisions.md, "Repairs"; `../shared/reliability` items 10-16), made from a
 //! generated humanoid pair whose ground truth is exact: seams split, a triangle soup, scan
 //! debris, a far vertex, a point cloud with an outlier or every point twice. Each must be
 //! repaired (with its warning) to within 0.02 of the clean pair's one-to-one region

@@ -1,5 +1,5 @@
 //! Transfer through the surface map, against the exact ground truth of generated figures
-//! (issue 21): skin weights, re-posing with them, and where B's vertices land on A.
+//! (docs/transfer.md): skin weights, re-posing with them, and where B's vertices land on A.
 //!
 //! The figures' rest meshes at two resolutions are two samplings of one surface, so the true
 //! image of a vertex of B is the closest point of A's rest mesh to B's rest vertex, and B's
@@ -222,7 +222,7 @@ fn skin_weights_carried_to_another_pose_and_body_pose_it_as_its_own() {
             .map(|f| f.confidence)
             .collect::<Vec<_>>()
     );
-    // The issue's targets, on every pair whose map is right: weights within 0.05 per vertex
+    // The targets (docs/transfer.md), on every pair whose map is right: weights within 0.05 per vertex
     // and bone, re-posing within 2% of the height.
     for f in &right {
         assert!(f.weights[1] <= 0.05 && f.repose[1] <= 0.02, "{f:?}");

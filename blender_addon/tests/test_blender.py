@@ -311,9 +311,9 @@ def test_the_extension_ships_a_small_library_and_its_licences():
         sizes = {i.filename: i.file_size for i in archive.infolist()}
     library = [name for name in sizes if name.startswith("shapecorr/libshapecorr")]
     assert library, sorted(sizes)
-    # Built with the `dist` profile, no debug information (issue 17: at most 8 MB).
+    # Built with the `dist` profile, no debug information (the target is at most 8 MB).
     assert sizes[library[0]] <= 8 * 1024 * 1024, sizes[library[0]]
-    # The manifest's licence and the project's two travel with it (issue 23).
+    # The manifest's licence and the project's two travel with it.
     with zipfile.ZipFile(zip_path) as archive:
         manifest = archive.read("blender_manifest.toml").decode()
         licences = {name: archive.read(name).decode() for name in
@@ -339,7 +339,7 @@ def test_render_the_coloured_figures_with_cycles(addon, tmp_path):
     assert len(saturated) > 200
 
 
-# ------------------------------------------------------------------------ Transfer (issue 21)
+# ----------------------------------------------------------------------------------- Transfer
 
 
 def library_shape(addon, obj):

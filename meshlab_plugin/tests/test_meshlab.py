@@ -177,7 +177,7 @@ def test_the_repairs_made_are_reported(tmp_path):
     assert "shapecorr_meshlab: repaired B: 1 vertices far from" in run.stderr, run.stderr
 
 
-# ------------------------------------------------------------------------ transfer (issue 21)
+# ----------------------------------------------------------------------------------- transfer
 
 
 def painted_pair():

@@ -1,4 +1,5 @@
-//! Collections (issue 22): many pairs of a set of shapes, each shape's work done once.
+//! Collections (docs/collections.md): many pairs of a set of shapes, each shape's work done
+//! once.
 //!
 //! The data flow of a batch:
 //! - a shape file -> [`Batch::prepare`]: read (and repaired), its proxy when dense

@@ -1,4 +1,4 @@
-//! Region hypotheses verified at the map level (docs/design.md, 12.1 and 13.4; issue 18).
+//! Region hypotheses verified at the map level (docs/design.md, 12.1 and 13.4).
 //!
 //! A one-to-one region answer can be wrong in ways the region energy cannot see: the mirror
 //! image of the truth (paper, section 5.2), or two parts of one symmetric group swapped (a
@@ -75,10 +75,11 @@ impl MapEnergy {
     /// The cost the hypotheses are ranked by (lower is better): the distortion divided by
     /// the square of the coverage times the orientation kept (where it is known). A swapped
     /// part stretches distances; a fold reaches fewer samples; a mirror image turns
-    /// triangles over. Measured in docs/decisions.md (issue 18): on 178 development pairs
-    /// (camel gallop, FAUST_r, TOSCA_r, FAUST) the best of 144 products of powers of these
-    /// energies and the residual; the plain `distortion / (coverage x orientation)` failed
-    /// one pair more, every product with the residual two more.
+    /// triangles over. Measured in docs/decisions.md, "Hypotheses verified at the map
+    /// level": on 178 development pairs (camel gallop, FAUST_r, TOSCA_r, FAUST) the best of
+    /// 144 products of powers of these energies and the residual; the plain
+    /// `distortion / (coverage x orientation)` failed one pair more, every product with the
+    /// residual two more.
     pub fn cost(&self) -> f64 {
         let consistency = self.coverage * self.orientation.unwrap_or(1.0);
         self.distortion / consistency.max(1e-3).powi(2)
@@ -161,7 +162,7 @@ const OPTIONS_CAP: usize = 5040;
 /// Single-group alternatives kept as hypotheses, the best by region distortion. More did
 /// not change the chosen maps' errors on the development pairs (answer, mirror and
 /// symmetric alone: the same means within 0.0003) and cost 0.3 s each per FAUST pair.
-/// (Until issue 18's third stop the limit was written as 1 but two were kept: the
+/// (Until the verification's third stop the limit was written as 1 but two were kept: the
 /// figures measured were with two.)
 pub const MAX_ALTERNATIVES: usize = 2;
 
@@ -169,9 +170,9 @@ pub const MAX_ALTERNATIVES: usize = 2;
 /// on point clouds a mirror image is as right as the answer), the symmetric groups, and up
 /// to [`MAX_ALTERNATIVES`] single-group alternatives ranked by the distortion of region
 /// distances. Duplicates are left out. (A further rearrangement of every group at once, a
-/// quadruped's front and back legs swapped, was tried at issue 18's third stop and
-/// removed at the fourth: over all 479 benchmark pairs it fixed no failure and added one;
-/// docs/decisions.md, "Rearrangements".)
+/// quadruped's front and back legs swapped, was tried at the verification's third stop
+/// and removed at the fourth: over all 479 benchmark pairs it fixed no failure and added
+/// one; docs/decisions.md, "Hypotheses verified at the map level", "Rearrangements".)
 pub fn candidates(
     side_a: ShapeBasis<'_>,
     side_b: ShapeBasis<'_>,
@@ -487,7 +488,7 @@ fn residual(s: &SampledZoomOut, basis_a: &Eigenbasis, basis_b: &Eigenbasis) -> f
 /// ([`full_consistency`]). The sample energies cannot tell a body's map from the one turned
 /// front to back with left and right swapped (both keep the orientation, the limbs are near
 /// cylinders); at full resolution the turned map folds the feet and face and reaches fewer
-/// vertices. Measured on 123 development pairs (issue 18, docs/decisions.md "Close calls"):
+/// vertices. Measured on 123 development pairs (docs/decisions.md, "Close calls"):
 /// FAUST_r failures 6 -> 1 of 29, TOSCA_r 3 -> 2, camel gallop and FAUST unchanged, at
 /// every ratio from 1.2 to 3.
 pub const CLOSE_CALL: f64 = 1.5;
@@ -666,7 +667,7 @@ pub fn confidence(scores: &[HypothesisScore], chosen: usize) -> f64 {
 /// `dissimilar_shapes_are_doubtful_and_warn`).
 pub const COST_SCALE: f64 = 0.5;
 /// The relative cost margin at which the margin factor of the confidence is 1 - 1/e.
-/// Calibrated on 125 development pairs (issue 18, docs/decisions.md "Confidence"): below
+/// Calibrated on 125 development pairs (docs/decisions.md, "Confidence"): below
 /// [`DOUBTFUL_BELOW`] the confidence flagged the 5 failed pairs and 12 of the 120 good ones
 /// (the same for 0.03); at the earlier 0.2 a good map only 10% clear of its runner-up was
 /// doubtful, and 35 of the 120 good pairs were flagged.
@@ -767,7 +768,8 @@ pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
 /// The shape's vertices, divided by a power of two near its size (exact) when it is far
 /// from unit size: a normal is a product of two lengths and the orientation test a product
 /// of two normals, which underflow to 0 on a 1e-100-scaled shape (its confidence was 0:
-/// issue 19). Shapes of ordinary size are used as they are.
+/// docs/decisions.md, "Shapes far from unit size"). Shapes of ordinary size are used as
+/// they are.
 fn unit_size_vertices(shape: &Shape) -> std::borrow::Cow<'_, [[f64; 3]]> {
     let vertices = shape.vertices();
     let (lo, hi) = crate::shape::bounding_box(vertices);

@@ -1,6 +1,6 @@
-//! The map onto A's surface (issue 21): for every vertex of B, a point of A's surface (three
-//! vertices of A and weights, [`SurfacePoint`]), so that data carried from A to B is as smooth
-//! as A's and not quantised to A's vertices.
+//! The map onto A's surface (docs/transfer.md, "The surface map"): for every vertex of B, a
+//! point of A's surface (three vertices of A and weights, [`SurfacePoint`]), so that data
+//! carried from A to B is as smooth as A's and not quantised to A's vertices.
 //!
 //! Method: the vertex map is smoothed over B's one-ring and projected back onto A. Every
 //! vertex of B takes the mean of the images of itself and its neighbours (one-ring on a mesh,

@@ -1,7 +1,8 @@
-//! What one job may use: a memory ceiling and a time limit (issue 19). Both are checked
-//! against an estimate before any work, so a job that cannot fit is refused at once with
-//! the reason; the time limit is also enforced while the job runs, through the same checks
-//! that honour a cancel (within a fraction of a second in every long stage).
+//! What one job may use: a memory ceiling and a time limit (docs/decisions.md, "Budget").
+//! Both are checked against an estimate before any work, so a job that cannot fit is
+//! refused at once with the reason; the time limit is also enforced while the job runs,
+//! through the same checks that honour a cancel (within a fraction of a second in every
+//! long stage).
 //!
 //! The estimates are models of what the pipeline allocates and computes, with constants
 //! measured on generated humanoids (docs/decisions.md, "Budget"): the peak memory of the

@@ -1,4 +1,4 @@
-//! The multiresolution path for dense shapes (issue 20; docs/design.md, step 16).
+//! The multiresolution path for dense shapes (docs/design.md, step 16).
 //!
 //! Above [`Multiresolution::above`] active vertices a shape is replaced by a proxy of about
 //! [`Multiresolution::proxy_vertices`] vertices ([`Proxy`]); the whole pipeline runs on the

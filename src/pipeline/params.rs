@@ -39,7 +39,7 @@ pub struct Params {
     /// Choose the one-to-one matches among hypotheses (the answer, its mirror image, the
     /// symmetric groups, single-group alternatives) by their maps refined on the regions'
     /// eigenbasis ([`crate::maps::hypotheses`]), and give the answer a confidence. Measured
-    /// in docs/decisions.md (issue 18).
+    /// in docs/decisions.md, "Hypotheses verified at the map level".
     pub verify_hypotheses: bool,
     /// Dense shapes run on proxies ([`crate::pipeline::multiresolution`]): above 12K vertices, proxies
     /// of about 8K.

@@ -921,8 +921,9 @@ fn representatives(vertices: &[[f64; 3]], active: &[u32]) -> Vec<u32> {
 /// Area of triangle `t`.
 ///
 /// The edges are scaled by a power of two before the cross product (exact, so the result is
-/// bit-identical for ordinary sizes), so a tiny or huge shape (a 1e-100 scale: issue 19)
-/// does not underflow or overflow in the squared lengths.
+/// bit-identical for ordinary sizes), so a tiny or huge shape (a 1e-100 scale:
+/// docs/decisions.md, "Shapes far from unit size") does not underflow or overflow in the
+/// squared lengths.
 pub fn triangle_area(vertices: &[[f64; 3]], t: &[u32; 3]) -> f64 {
     let [a, b, c] = t.map(|i| vertices[i as usize]);
     let u = sub(&b, &a);

@@ -1,4 +1,4 @@
-//! Coarse proxies of dense shapes (issue 20; docs/design.md, step 16): the pipeline runs on a
+//! Coarse proxies of dense shapes (docs/design.md, step 16): the pipeline runs on a
 //! proxy of a few thousand vertices and its answers come back to every input vertex.
 //!
 //! A mesh is simplified by meshoptimizer's edge collapse (`meshopt::simplify`, quadric

@@ -1,5 +1,6 @@
-//! Repairs of what real files contain (issue 19): vertices split along UV seams or never
-//! welded (triangle soups), scan debris (small loose pieces), far vertices and outlier points.
+//! Repairs of what real files contain (docs/decisions.md, "Repairs"): vertices split along
+//! UV seams or never welded (triangle soups), scan debris (small loose pieces), far
+//! vertices and outlier points.
 //!
 //! Every repair keeps the caller's vertex order: a repaired-away vertex becomes inactive and
 //! takes the values of an active one ([`super::Shape::representative`]): a welded duplicate

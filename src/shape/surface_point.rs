@@ -1,5 +1,6 @@
 //! Points of a shape's surface as three vertices and weights: where an input vertex lies on
-//! its proxy (issue 20) and where a vertex of B lands on A (the surface map, issue 21).
+//! its proxy (docs/design.md, step 16) and where a vertex of B lands on A (the surface map,
+//! docs/transfer.md).
 
 /// A point of a shape's surface: three of its vertices and their weights (summing to 1),
 /// heaviest first. On a mesh the vertices are a triangle's and the weights barycentric; on

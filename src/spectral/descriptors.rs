@@ -157,8 +157,8 @@ const ZERO_EIGENVALUE: f64 = 1e-9;
 /// `(Phi .* Phi) W`: squared eigenvectors combined with per-eigenvalue weights.
 /// `out[v, j] = sum_i phi_i(v)^2 weights[i, j]`, summed in the order of `i` for every
 /// vertex: a matrix product whose blocking (and so its rounding) would depend on the
-/// number of threads (issue 19: descriptors differed in the last digits between 1 and 2
-/// threads).
+/// number of threads (docs/decisions.md, "Determinism across thread counts": descriptors
+/// differed in the last digits between 1 and 2 threads).
 fn squared_vectors_times(basis: &Eigenbasis, weights: &Mat<f64>) -> Mat<f64> {
     use rayon::prelude::*;
     let (n, k, t) = (basis.vectors.nrows(), basis.len(), weights.ncols());

@@ -33,7 +33,8 @@ pub struct EigenParams {
     pub n_eigenpairs: usize,
     /// Shift `sigma` of `A = L + sigma M` on the unit-area shape. The smallest eigenvalues
     /// of a unit-area shape are O(1), so sigma = 1 keeps A well conditioned (a shift near 0
-    /// made faer's solver return inaccurate and repeated eigenpairs: issue 2).
+    /// made faer's solver return inaccurate and repeated eigenpairs:
+    /// docs/decisions.md, "Eigensolver").
     pub shift: f64,
     /// Convergence: a Ritz pair is accepted when its residual in the shift-inverted operator
     /// is below `tolerance * theta`.
@@ -76,9 +77,10 @@ impl Default for EigenParams {
 /// under 250 MiB.
 pub const CONCURRENT_BELOW: usize = 20_000;
 
-/// Default [`EigenParams::max_vertices`]: 2 million vertices. Measured (issue 19): a
-/// 300K-vertex pair took 289 s and 1.47 GB on a 2-core machine, so 2M is about 10 GB and
-/// half an hour, the most a desktop can do; larger shapes should be simplified first.
+/// Default [`EigenParams::max_vertices`]: 2 million vertices. Measured (docs/decisions.md,
+/// "Size limits"): a 300K-vertex pair took 289 s and 1.47 GB on a 2-core machine, so 2M is
+/// about 10 GB and half an hour, the most a desktop can do; larger shapes should be
+/// simplified first.
 pub const DEFAULT_MAX_VERTICES: usize = 2_000_000;
 
 /// The threads the dense products use: `threads` (0: all) clamped to the machine's cores,
@@ -96,8 +98,9 @@ pub fn effective_threads(threads: usize) -> usize {
 /// [`FAER_SPLIT`] tasks, once per process. faer splits work by its `Par`'s thread count and
 /// the split changes the rounding; its default, `Par::rayon(0)`, takes the size of the
 /// current rayon pool, so results differed in the last digits between RAYON_NUM_THREADS=1
-/// and 2 (issue 19). A constant split (not the machine's cores) keeps them bit-identical for
-/// any pool size on any machine; the tasks run on however many threads the pool has.
+/// and 2 (docs/decisions.md, "Determinism across thread counts"). A constant split (not the
+/// machine's cores) keeps them bit-identical for any pool size on any machine; the tasks
+/// run on however many threads the pool has.
 pub fn fix_faer_parallelism() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| faer::set_global_parallelism(Par::rayon(FAER_SPLIT)));

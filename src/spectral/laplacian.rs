@@ -60,7 +60,8 @@ impl Laplacian {
     pub(crate) fn from_triangulation(t: &Triangulation) -> Result<Laplacian> {
         // Cotangent weights do not change with scale and the mass scales by s^2, so a shape
         // far from unit size (1e-100: its areas underflow) is computed with its lengths
-        // divided by a power of two (exact) and its area scaled back (issue 19).
+        // divided by a power of two (exact) and its area scaled back (docs/decisions.md,
+        // "Shapes far from unit size").
         let longest = t.lengths.iter().flatten().fold(0.0f64, |m, l| m.max(*l));
         let scale = if (1e-50..1e50).contains(&longest) {
             1.0

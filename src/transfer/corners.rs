@@ -1,5 +1,5 @@
 //! Per-corner data (texture coordinates) carried from A's triangles to B's, seams kept
-//! (issue 21).
+//! (docs/transfer.md, "Texture coordinates per corner").
 //!
 //! A seam of A is an edge whose two triangles carry different values at its corners. Every
 //! corner of B is located on A by the [`SurfaceMap`] (a triangle of A and weights) and takes

@@ -1,6 +1,6 @@
-//! Carrying per-vertex data from A to B through a [`SurfaceMap`] (issue 21): continuous
-//! values interpolated, labels taken from the nearest vertex, skin weights interpolated and
-//! renormalised; per-corner data (texture coordinates) with its seams
+//! Carrying per-vertex data from A to B through a [`SurfaceMap`] (docs/transfer.md):
+//! continuous values interpolated, labels taken from the nearest vertex, skin weights
+//! interpolated and renormalised; per-corner data (texture coordinates) with its seams
 //! ([`SurfaceMap::transfer_corners`]).
 
 mod corners;

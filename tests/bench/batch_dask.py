@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Benchmark: a batch on Dask against the local batch, and Dask's overhead per task
-(issue 22; docs/collections.md).
+(docs/collections.md, "Dask against the local batch, and Dask's cost per task").
 
 Runs the same pairs, each run from an empty cache (eigenbases included), in one script:
 1. `shapecorr batch` (the reference: the Rust batch, pairs in parallel on this machine);

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Eigensolver benchmark against scipy (issue 2). Builds shapecorr, makes a virtual
+# Eigensolver benchmark against scipy (docs/decisions.md, "Eigensolver"). Builds shapecorr, makes a virtual
 # environment with numpy and scipy, and runs tests/bench/eigen_vs_scipy.py.
 # Usage: tests/bench/eigen.sh [--data DIR] [--repeat N]
 set -euo pipefail

@@ -1,5 +1,5 @@
 """Benchmark: the Blender Transfer operator end to end on a generated 30K-vertex pair
-(issue 21's target: at most 3 s), against the library alone on the same data in the same run.
+(the target: at most 3 s; docs/transfer.md), against the library alone on the same data in the same run.
 
     bash tests/blender/run.sh   # once: builds the extension's environment
     target/blender-venv/bin/python tests/blender/bench_transfer.py [--size 30000] [--repeat 3]

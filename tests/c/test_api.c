@@ -139,7 +139,7 @@ static void test_options(void) {
     sc_params_free(NULL);
 }
 
-/* Issue 19: every option at extreme values (0, -1, 1e12, NaN, +-inf, 1e300) gives OK or
+/* Every option at extreme values (0, -1, 1e12, NaN, +-inf, 1e300) gives OK or
    INVALID_PARAMETER naming that option, never PANIC or an abort; the range functions agree. */
 static void test_option_extremes(void) {
     static const double extremes[] = {0.0, -1.0, 1e12, 1e300, -1e300};
@@ -173,7 +173,7 @@ static void test_option_extremes(void) {
                       "%s = %g accepted outside [%g, %g]", name, v, lo, hi);
         }
     }
-    /* The reproducers of issue 19, item 3: refused at once, naming the option. */
+    /* Values that once aborted or hung: refused at once, naming the option. */
     CHECK_STATUS(sc_params_set_int(params, "histogram_bins", 1000000000000LL),
                  SC_STATUS_INVALID_PARAMETER);
     CHECK_STATUS(sc_params_set_int(params, "hks_times", 100000000), SC_STATUS_INVALID_PARAMETER);
@@ -737,7 +737,7 @@ static void test_pointwise_errors(void) {
     CHECK_STATUS(sc_pointwise_map(a, NULL, NULL, NULL, NULL, &p), SC_STATUS_NULL_ARGUMENT);
     CHECK_STATUS(sc_pointwise_map(a, a, NULL, NULL, NULL, NULL), SC_STATUS_NULL_ARGUMENT);
     CHECK(strstr(sc_last_error(), "out_pointwise") != NULL, "message: %s", sc_last_error());
-    /* A value out of its own range is refused when set (issue 19). */
+    /* A value out of its own range is refused when set (docs/decisions.md, "Option ranges"). */
     CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
     CHECK_STATUS(sc_params_set_int(params, "p2p_zoomout_step", 0), SC_STATUS_INVALID_PARAMETER);
     sc_params_free(params);
@@ -1010,7 +1010,7 @@ static void test_concurrency(void) {
     sc_shape_free(b);
 }
 
-/* Issue 19, item 7: kmeans_restarts at its largest (minutes of work) stops promptly. */
+/* kmeans_restarts at its largest (minutes of work) stops promptly. */
 static bool cancel_in_segmentation(void *userdata, uint32_t stage, float fraction) {
     double *due = (double *)userdata;
     (void)fraction;
@@ -1040,7 +1040,7 @@ static void test_cancel_huge_restarts(void) {
     sc_shape_free(b);
 }
 
-/* ---------------------------------------------------------------- transfer (issue 21) */
+/* --------------------------------------------------------------------------- transfer */
 
 static bool cancel_transfer(void *userdata, uint32_t stage, float fraction) {
     int *calls = (int *)userdata;

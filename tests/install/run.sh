@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The C/C++ install, tested as a user meets it (issue 23):
+# The C/C++ install, tested as a user meets it (docs/decisions.md, "Native install: cargo-c"):
 # - `cargo cinstall` (cargo-c, installed here if missing) into a staging folder (--prefix +
 #   --destdir) and into a temporary prefix;
 # - the installed library's soname, the header's SC_ABI_VERSION and sc_abi_version() agree;

@@ -1,4 +1,4 @@
-"""Collections from Python (issue 22): ``shapecorr.batch`` locally and on a Dask
+"""Collections from Python (docs/collections.md): ``shapecorr.batch`` locally and on a Dask
 ``LocalCluster`` with 2 worker processes gives every pair the answer of ``shapecorr.match``;
 a worker killed during the run loses and duplicates no pair; bad entries are failed pairs."""
 

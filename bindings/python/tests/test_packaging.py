@@ -28,7 +28,7 @@ DISTRIBUTION = importlib.metadata.distribution("shapecorr")
 def test_installed_package_uses_its_packaged_library():
     assert PACKAGE.parent == Path(sysconfig.get_paths()["platlib"]).resolve()
     assert _lib.LIBRARY_PATH.parent == PACKAGE
-    # Shipped without debug information (the `dist` profile; issue 17: at most 8 MB).
+    # Shipped without debug information (the `dist` profile; the target is at most 8 MB).
     size = _lib.LIBRARY_PATH.stat().st_size
     assert size <= 8 * 1024 * 1024, f"packaged library is {size / 2**20:.1f} MiB"
 

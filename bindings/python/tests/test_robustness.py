@@ -1,4 +1,4 @@
-"""Issue 19: the binding never crashes the interpreter. Wrong objects where a handle goes,
+"""The binding never crashes the interpreter. Wrong objects where a handle goes,
 closed handles, out-of-range integers, float indices and NULs in paths raise Python errors;
 Ctrl-C and falsy callback returns cancel."""
 

@@ -248,7 +248,8 @@ def test_life_cycle(humanoids):
 
 def test_dissimilar_shapes_are_doubtful_with_a_warning():
     """An eight-limbed star against a quadruped: no consistent map (confidence 0.003 measured;
-    a six-limbed star, 0.41, was too near the threshold after issue 18's recalibration)."""
+    a six-limbed star, 0.41, was too near the threshold after the confidence was recalibrated,
+    docs/decisions.md, "Confidence")."""
     a, b = shapecorr.Shape.figure("star8", 1, 2000), shapecorr.Shape.figure("quadruped", 1, 2000)
     result = shapecorr.match(a, b)
     check_confidence(result)
@@ -521,7 +522,7 @@ def test_bad_repair_arguments_raise():
     assert any("far from" in w for w in cloud.warnings), cloud.warnings
 
 
-# ------------------------------------------------------------------------ transfer (issue 21)
+# ----------------------------------------------------------------------------------- transfer
 
 
 def test_transfer_modes_agree_with_the_surface_points(humanoids):

@@ -101,7 +101,7 @@ fn main() -> ExitCode {
 
 /// `shapecorr info F | head -1`: when the reader closes the pipe, end as every Unix tool
 /// does (killed by SIGPIPE, no message) instead of panicking in `println!`. Rust ignores
-/// SIGPIPE by default, which turns the closed pipe into a panic (issue 19).
+/// SIGPIPE by default, which turns the closed pipe into a panic.
 fn quit_quietly_on_closed_pipe() {
     #[cfg(unix)]
     // SAFETY: restoring a signal's default disposition at start-up, before any thread.

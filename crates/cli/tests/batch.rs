@@ -1,6 +1,6 @@
-//! `shapecorr batch` end to end (issue 22): the same answer per pair as `match` and `p2p`,
-//! each eigenbasis computed once, a killed run resumed without recomputing, bad entries
-//! recorded as failed pairs.
+//! `shapecorr batch` end to end (docs/collections.md): the same answer per pair as `match`
+//! and `p2p`, each eigenbasis computed once, a killed run resumed without recomputing, bad
+//! entries recorded as failed pairs.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

@@ -297,7 +297,7 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
     let b = dir.join("b.ply");
     let cloud = dir.join("cloud.ply");
     // Pose 3 (pose 4 is a known weak case: a partial left/right flip of the one-to-one
-    // regions leaves 17% of the vertices on the wrong side; see the issue 6 note).
+    // regions leaves 17% of the vertices on the wrong side).
     for (path, pose, points) in [
         (&a, "0", None),
         (&b, "3", None),
@@ -575,8 +575,9 @@ fn an_unverified_match_has_no_confidence() {
 /// An eight-limbed star against a quadruped (eight extremities against six): no map between
 /// them is consistent, so `match` and `p2p` call the answer doubtful (measured confidence
 /// 0.003 and 0.17): the warning is in result.json, on stderr (one line) and the summary says
-/// "doubtful"; the command succeeds. (A six-limbed star was used until issue 18's third
-/// stop; its six limbs map onto the quadruped's four legs, head and tail at the cost of a
+/// "doubtful"; the command succeeds. (A six-limbed star was used until the
+/// confidence was recalibrated, docs/decisions.md, "Confidence"; its six limbs map onto
+/// the quadruped's four legs, head and tail at the cost of a
 /// good map, 0.27, and the recalibrated `p2p` confidence, 0.58, no longer calls it doubtful.)
 #[test]
 fn dissimilar_shapes_are_doubtful_and_warn() {

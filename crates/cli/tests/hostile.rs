@@ -1,4 +1,4 @@
-//! Issue 19 on the command line: odd file names, special files, extreme option values and
+//! Robustness on the command line: odd file names, special files, extreme option values and
 //! bad shapes in a pair end with a clear one-line error (or work), never a panic or a hang.
 //! Unix only: it names files with non-UTF-8 bytes and links to /dev/zero.
 #![cfg(unix)]
@@ -186,7 +186,7 @@ fn a_bad_shape_in_a_pair_names_its_side_and_file() {
     }
 }
 
-/// Issue 19, item 9: stderr that is not a terminal gets progress lines (at most one a
+/// Stderr that is not a terminal gets progress lines (at most one a
 /// second), `--quiet` none.
 #[test]
 fn progress_is_written_as_lines_when_stderr_is_not_a_terminal() {
@@ -248,7 +248,7 @@ fn result_json(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap()
 }
 
-/// Issue 19, item 3: a memory ceiling below the job's estimate is refused before any work,
+/// A memory ceiling below the job's estimate is refused before any work,
 /// naming `memory_limit_mib`; at a ceiling the estimate fits, the job runs and its measured
 /// peak stays within 10% of the ceiling (`result.json`'s `budget`).
 #[test]

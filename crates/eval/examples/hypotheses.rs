@@ -1,4 +1,5 @@
-//! Which map energy tells a right region hypothesis from a wrong one (issue 18): for every
+//! Which map energy tells a right region hypothesis from a wrong one
+//! (docs/decisions.md, "Hypotheses verified at the map level"): for every
 //! pair of the datasets given, every hypothesis the default pipeline verifies, with its
 //! energies, its cost, whether it was chosen, and its full-resolution map's mean geodesic
 //! error against the ground truth (and with the flip allowed, where a mirror map exists), and

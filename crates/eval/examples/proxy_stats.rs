@@ -1,4 +1,5 @@
-//! The quality of the proxies the library would make (issue 20): for every shape file given,
+//! The quality of the proxies the library would make (docs/decisions.md, "Dense shapes:
+//! proxies"): for every shape file given,
 //! the time to read and to simplify it, the proxy's size, pieces and repairs, its smallest
 //! triangle angles (1st and 10th percentile) and its area against the input's.
 //!

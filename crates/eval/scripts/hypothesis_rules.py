@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Replays selection rules on the `hypotheses` example's JSON lines (issue 18).
+"""Replays selection rules on the `hypotheses` example's JSON lines
+(docs/decisions.md, "Confidence").
 
     cargo run --release -p shapecorr-eval --example hypotheses -- --cache DIR --limit N \
         DATASET > DATASET.jsonl

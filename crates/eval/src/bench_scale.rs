@@ -1,4 +1,4 @@
-//! `shapecorr bench scale` (issue 20): time, peak memory and accuracy of `match` and `p2p`
+//! `shapecorr bench scale` (docs/scale.md): time, peak memory and accuracy of `match` and `p2p`
 //! on generated humanoid pairs from 5K to 1M vertices, each command a fresh process of the
 //! `shapecorr` tool (so its peak memory is its own), with the full-resolution path and
 //! pyFM (WKS + ZoomOut) as references where they finish.

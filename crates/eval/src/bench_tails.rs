@@ -1,4 +1,4 @@
-//! Every pair of every dataset, judged by its tails (`shapecorr bench tails`, issue 18): the
+//! Every pair of every dataset, judged by its tails (`shapecorr bench tails`; docs/tails.md): the
 //! default pipeline (regions verified at the map level, then the map) on each pair, with the
 //! region accuracies, the map's mean geodesic error (no flip: every input here is a mesh,
 //! whose orientation is known), the confidence and the seconds. The page lists per dataset
@@ -178,11 +178,11 @@ pub fn tails_page(records: &[TailRecord], command: &str) -> String {
     let _ = writeln!(s, "# Tails: every pair of every dataset\n");
     let _ = writeln!(
         s,
-        "Made by `{command}` (issue 18). The default pipeline on every pair of every list: regions verified \
+        "Made by `{command}` (docs/decisions.md, "Hypotheses verified at the map level"). The default pipeline on every pair of every list: regions verified \
          at the map level, then the map. Error: mean geodesic error / sqrt(area) on 1000 sampled \
          ground-truth pairs, no flip allowed (every input is a mesh). Failed: above {} and above {}. \
          Shapes above the default `proxy_above` (12K vertices: TOSCA's) run on proxies as the \
-         library runs them (issue 20; `--full-resolution` turns that off).\n",
+         library runs them (docs/design.md, step 16; `--full-resolution` turns that off).\n",
         FAILED_ERRORS[0], FAILED_ERRORS[1]
     );
     let datasets: Vec<&str> = {

@@ -1,5 +1,5 @@
 //! The tails of a benchmark: not only the mean but the median, the worst pair and how many
-//! pairs failed (issue 18: failures are reported, not averaged away).
+//! pairs failed (failures are reported, not averaged away).
 
 use std::fmt::Write as _;
 

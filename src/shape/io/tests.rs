@@ -250,7 +250,7 @@ fn encode_checks_parameters() {
     ));
 }
 
-/// Issue 19, item 15: only ASCII white space separates numbers. A U+0085 (next line),
+/// Only ASCII white space separates numbers. A U+0085 (next line),
 /// U+00A0 (no-break space) or U+2003 (em space) inside or between numbers is an error
 /// naming the file and the line, never two numbers.
 #[test]
