@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use common::permutation;
-use faer::Mat;
+use faer::{Mat, MatRef};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use shapecorr::regions::graph::ShapeGraph;
@@ -24,6 +24,15 @@ use shapecorr::synth::{figure, figure_poses, FigureKind, FigureSpec, Proportions
 use shapecorr::NoProgress;
 use shapecorr::ReadAs;
 use shapecorr::{EigenParams, Eigenbasis, Shape};
+
+/// One shape as `segment_pair` reads it.
+fn described<'a>(shape: &'a Shape, mass: &'a [f64], descriptors: MatRef<'a, f64>) -> Described<'a> {
+    Described {
+        shape,
+        mass,
+        descriptors,
+    }
+}
 
 // ---------------------------------------------------------------------------------------
 // Helpers
@@ -650,16 +659,8 @@ fn two_poses_give_consistent_segmentations_independent_of_vertex_order() {
     let (a, b) = hks_pair(4000);
     let params = SegmentationParams::default();
     let result = segment_pair(
-        Described {
-            shape: &a.shape,
-            mass: &a.mass,
-            descriptors: a.hks.as_ref(),
-        },
-        Described {
-            shape: &b.shape,
-            mass: &b.mass,
-            descriptors: b.hks.as_ref(),
-        },
+        described(&a.shape, &a.mass, a.hks.as_ref()),
+        described(&b.shape, &b.mass, b.hks.as_ref()),
         &params,
         &mut NoProgress,
     )
@@ -687,16 +688,8 @@ fn two_poses_give_consistent_segmentations_independent_of_vertex_order() {
     let mass_p: Vec<f64> = p.iter().map(|&i| a.mass[i]).collect();
     let hks_p = Mat::from_fn(n, a.hks.ncols(), |i, j| a.hks[(p[i], j)]);
     let again = segment_pair(
-        Described {
-            shape: &shape_p,
-            mass: &mass_p,
-            descriptors: hks_p.as_ref(),
-        },
-        Described {
-            shape: &b.shape,
-            mass: &b.mass,
-            descriptors: b.hks.as_ref(),
-        },
+        described(&shape_p, &mass_p, hks_p.as_ref()),
+        described(&b.shape, &b.mass, b.hks.as_ref()),
         &params,
         &mut NoProgress,
     )
@@ -740,16 +733,8 @@ fn segment_pair_falls_back_when_no_k_is_acceptable() {
         ..Default::default()
     };
     let result = segment_pair(
-        Described {
-            shape: &two.shape,
-            mass: &two.mass,
-            descriptors: two.hks.as_ref(),
-        },
-        Described {
-            shape: &two.shape,
-            mass: &two.mass,
-            descriptors: two.hks.as_ref(),
-        },
+        described(&two.shape, &two.mass, two.hks.as_ref()),
+        described(&two.shape, &two.mass, two.hks.as_ref()),
         &params,
         &mut NoProgress,
     )
@@ -777,16 +762,8 @@ fn segment_pair_falls_back_when_no_k_is_acceptable() {
         ..Default::default()
     };
     let result = segment_pair(
-        Described {
-            shape: &one.shape,
-            mass: &one.mass,
-            descriptors: one.hks.as_ref(),
-        },
-        Described {
-            shape: &one.shape,
-            mass: &one.mass,
-            descriptors: one.hks.as_ref(),
-        },
+        described(&one.shape, &one.mass, one.hks.as_ref()),
+        described(&one.shape, &one.mass, one.hks.as_ref()),
         &tight,
         &mut NoProgress,
     )
@@ -802,11 +779,7 @@ fn segment_pair_rejects_bad_inputs() {
     let h = prepare(figure_shape(FigureKind::Star { limbs: 3 }, 0, 800));
     let run = |params: &SegmentationParams, mass: &[f64], desc: &Mat<f64>| {
         segment_pair(
-            Described {
-                shape: &h.shape,
-                mass: &h.mass,
-                descriptors: h.hks.as_ref(),
-            },
+            described(&h.shape, &h.mass, h.hks.as_ref()),
             Described {
                 shape: &h.shape,
                 mass,
@@ -898,16 +871,8 @@ fn print_variants<S: std::fmt::Display>(
             let (a, b) = (&shapes[&ia], &shapes[&ib]);
             let t = Instant::now();
             let result = segment_pair(
-                Described {
-                    shape: &a.shape,
-                    mass: &a.mass,
-                    descriptors: a.hks.as_ref(),
-                },
-                Described {
-                    shape: &b.shape,
-                    mass: &b.mass,
-                    descriptors: b.hks.as_ref(),
-                },
+                described(&a.shape, &a.mass, a.hks.as_ref()),
+                described(&b.shape, &b.mass, b.hks.as_ref()),
                 params,
                 &mut NoProgress,
             )
@@ -1111,16 +1076,8 @@ fn faust_metric_comparison() {
         for &(ia, ib) in &pairs {
             let (a, b) = (&shapes[&ia], &shapes[&ib]);
             let result = segment_pair(
-                Described {
-                    shape: &a.shape,
-                    mass: &a.mass,
-                    descriptors: a.hks.as_ref(),
-                },
-                Described {
-                    shape: &b.shape,
-                    mass: &b.mass,
-                    descriptors: b.hks.as_ref(),
-                },
+                described(&a.shape, &a.mass, a.hks.as_ref()),
+                described(&b.shape, &b.mass, b.hks.as_ref()),
                 &params,
                 &mut NoProgress,
             )
@@ -1190,16 +1147,8 @@ fn large_generated_pair_timing() {
     }
     let t = Instant::now();
     let result = segment_pair(
-        Described {
-            shape: &a.shape,
-            mass: &a.mass,
-            descriptors: a.hks.as_ref(),
-        },
-        Described {
-            shape: &b.shape,
-            mass: &b.mass,
-            descriptors: b.hks.as_ref(),
-        },
+        described(&a.shape, &a.mass, a.hks.as_ref()),
+        described(&b.shape, &b.mass, b.hks.as_ref()),
         &SegmentationParams::default(),
         &mut NoProgress,
     )

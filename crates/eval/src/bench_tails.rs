@@ -178,7 +178,7 @@ pub fn tails_page(records: &[TailRecord], command: &str) -> String {
     let _ = writeln!(s, "# Tails: every pair of every dataset\n");
     let _ = writeln!(
         s,
-        "Made by `{command}` (docs/decisions.md, "Hypotheses verified at the map level"). The default pipeline on every pair of every list: regions verified \
+        "Made by `{command}` (docs/decisions.md, \"Hypotheses verified at the map level\"). The default pipeline on every pair of every list: regions verified \
          at the map level, then the map. Error: mean geodesic error / sqrt(area) on 1000 sampled \
          ground-truth pairs, no flip allowed (every input is a mesh). Failed: above {} and above {}. \
          Shapes above the default `proxy_above` (12K vertices: TOSCA's) run on proxies as the \
