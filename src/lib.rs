@@ -13,13 +13,14 @@
 //! | joint segmentation, shape graphs, graph matching, one-to-one | [`regions`] ([`segmentation`](regions::segmentation), [`graph`](regions::graph), [`matching`](regions::matching), [`symmetry`](regions::symmetry)) |
 //! | distances on the surface (edge graph, heat method) | [`geodesic`] |
 //! | point-to-point maps | [`maps`] ([`fmap`](maps::fmap), [`pointwise`](maps::pointwise)) |
-//! | the whole job | [`correspondence`] ([`Correspondence`], [`Symmetry`]), [`maps::pointwise`] ([`PointwiseCorrespondence`]) |
+//! | the jobs that assemble the stages | [`pipeline`] ([`pipeline::run_pair`]: [`Correspondence`], [`PointwiseCorrespondence`], [`Symmetry`], the batch), with its [`budget`](pipeline::budget) and [`proxies`](pipeline::multiresolution) |
 //! | scores against ground truth | [`evaluation`] |
 //! | front ends | [`options`] (the one table of named options), [`ffi`] (the C API), [`colors`] |
 //! | test figures with exact ground truth | [`synth`] |
 //!
-//! [`progress`] carries progress reports and cancellation, [`budget`] the memory ceiling
-//! and time limit of a job; [`Error`] is the one error type.
+//! [`progress`] carries progress reports and cancellation, [`pipeline::budget`] the memory
+//! ceiling and time limit of a job; [`Error`] is the one error type. The stages never
+//! import [`pipeline`] (docs/design.md, "Code layout").
 //! The benchmark harness is the workspace crate `shapecorr-eval` (`crates/eval`), the
 //! command line `shapecorr-cli` (`crates/cli`).
 //!
