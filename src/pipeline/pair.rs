@@ -133,17 +133,34 @@ pub fn run_pair(
     let estimate = job.params.budget.check(&job.budget_job([a, b]))?;
     job.params.budget.run(progress, |progress| {
         let started = Instant::now();
-        let mut result = match shapes {
+        let mut answers = match shapes {
             PairShapes::Ready(a, b) => on_ready(a, b, job, progress)?,
             PairShapes::Two(a, b) => prepare_and_run([a, b], job, progress)?,
             PairShapes::Itself(a) => prepare_itself_and_run(a, job, progress)?,
         };
-        result.estimate = estimate;
-        result.total_s = started.elapsed().as_secs_f64();
-        result.regions.timings.total = result.total_s;
-        result.regions.estimate = Some(estimate);
-        Ok(result)
+        let total_s = started.elapsed().as_secs_f64();
+        let timings = &mut answers.regions.timings;
+        [timings.eigenbasis_a, timings.eigenbasis_b] = answers.eigenbasis_s;
+        timings.proxies = answers.proxies_s;
+        timings.total = total_s;
+        answers.regions.estimate = Some(estimate);
+        Ok(PairResult {
+            regions: answers.regions,
+            map: answers.map,
+            estimate,
+            eigenbasis_s: answers.eigenbasis_s,
+            proxies_s: answers.proxies_s,
+            total_s,
+        })
     })
+}
+
+/// What the steps of [`run_pair`] give it to assemble the result.
+struct Answers {
+    regions: Correspondence,
+    map: Option<PointwiseMap>,
+    eigenbasis_s: [f64; 2],
+    proxies_s: f64,
 }
 
 /// Two shapes: proxies, both eigenbases (side by side when small), then the pair.
@@ -151,7 +168,7 @@ fn prepare_and_run(
     [a, b]: [&Shape; 2],
     job: PairJob<'_>,
     progress: &mut dyn Progress,
-) -> Result<PairResult> {
+) -> Result<Answers> {
     let eigen = job.eigen_params();
     let started = Instant::now();
     let [proxy_a, proxy_b] = job
@@ -171,14 +188,12 @@ fn prepare_and_run(
         proxy: proxy_b.as_ref(),
         basis: &basis_b,
     };
-    let mut result = on_ready(ready_a, ready_b, job, progress)?;
-    result.eigenbasis_s = eigenbasis_s;
-    [
-        result.regions.timings.eigenbasis_a,
-        result.regions.timings.eigenbasis_b,
-    ] = eigenbasis_s;
-    add_proxy_time(&mut result, built, [&proxy_a, &proxy_b]);
-    Ok(result)
+    let mut answers = on_ready(ready_a, ready_b, job, progress)?;
+    answers.eigenbasis_s = eigenbasis_s;
+    if proxy_a.is_some() || proxy_b.is_some() {
+        answers.proxies_s += built;
+    }
+    Ok(answers)
 }
 
 /// One shape matched to itself: one proxy and one eigenbasis, used on both sides (the
@@ -187,7 +202,7 @@ fn prepare_itself_and_run(
     shape: &Shape,
     job: PairJob<'_>,
     progress: &mut dyn Progress,
-) -> Result<PairResult> {
+) -> Result<Answers> {
     let eigen = job.eigen_params();
     let started = Instant::now();
     check_max_vertices(shape, &eigen)?;
@@ -201,20 +216,12 @@ fn prepare_itself_and_run(
         proxy: proxy.as_ref(),
         basis: &basis,
     };
-    let mut result = on_ready(ready, ready, job, progress)?;
-    result.eigenbasis_s = [eigenbasis_s, 0.0];
-    result.regions.timings.eigenbasis_a = eigenbasis_s;
-    add_proxy_time(&mut result, built, [&proxy, &None]);
-    Ok(result)
-}
-
-/// Adds the proxies' building time to the lifting time already counted, when there are
-/// proxies.
-fn add_proxy_time(result: &mut PairResult, built: f64, proxies: [&Option<Proxy>; 2]) {
-    if proxies.iter().any(|p| p.is_some()) {
-        result.proxies_s += built;
-        result.regions.timings.proxies = result.proxies_s;
+    let mut answers = on_ready(ready, ready, job, progress)?;
+    answers.eigenbasis_s = [eigenbasis_s, 0.0];
+    if proxy.is_some() {
+        answers.proxies_s += built;
     }
+    Ok(answers)
 }
 
 /// The pair on prepared shapes: the regions (verified by maps on the regions' bases,
@@ -226,7 +233,7 @@ fn on_ready(
     b: ReadyShape<'_>,
     job: PairJob<'_>,
     progress: &mut dyn Progress,
-) -> Result<PairResult> {
+) -> Result<Answers> {
     let (working_a, working_b) = (
         ShapeBasis::new(a.working(), a.basis),
         ShapeBasis::new(b.working(), b.basis),
@@ -257,16 +264,10 @@ fn on_ready(
     } else {
         0.0
     };
-    regions.timings.proxies = proxies_s;
-    Ok(PairResult {
+    Ok(Answers {
         regions,
         map,
-        estimate: Estimate {
-            bytes: 0,
-            seconds: 0.0,
-        },
         eigenbasis_s: [0.0; 2],
         proxies_s,
-        total_s: 0.0,
     })
 }
