@@ -95,7 +95,7 @@ impl OptionInfo {
     }
 
     /// This integer option as a choice among `names`, by value (range `[0, n - 1]`).
-    const fn choices(self, names: &'static [&'static str]) -> OptionInfo {
+    const fn with_choices(self, names: &'static [&'static str]) -> OptionInfo {
         OptionInfo {
             choices: names,
             ..self.range(0.0, (names.len() - 1) as f64)
@@ -462,7 +462,7 @@ pub const OPTIONS: &[OptionInfo] = &[
             |o: &mut Options, v| o.pointwise.regions = P2P_REGIONS[v as usize],
         ),
     )
-    .choices(&P2P_REGIONS_NAMES),
+    .with_choices(&P2P_REGIONS_NAMES),
     p2p(
         "p2p_region_distances",
         "pointwise map: also constrain by the distance from each matched region",
@@ -521,7 +521,7 @@ pub const OPTIONS: &[OptionInfo] = &[
             },
         ),
     )
-    .choices(&P2P_REFINEMENT_NAMES),
+    .with_choices(&P2P_REFINEMENT_NAMES),
     p2p(
         "p2p_zoomout_end",
         "pointwise map: ZoomOut's final basis size (at most p2p_eigenpairs)",
