@@ -82,6 +82,7 @@ fn figure() -> Shape {
         pose: 1,
         target_vertices: 500,
         proportions: Proportions::default(),
+        ..Default::default()
     };
     let mesh = synth::figure(&spec).expect("a valid figure");
     let faces = mesh.triangles.iter().map(|t| t.to_vec()).collect();

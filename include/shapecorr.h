@@ -177,6 +177,11 @@ enum sc_status
   SC_STATUS_NUMERICAL_FAILURE = 17,
   // The progress callback returned false.
   SC_STATUS_CANCELLED = 18,
+  // The job is too big for a limit: refused before any work by its estimate
+  // (`memory_limit_mib`, `time_limit_s`, `max_vertices`, the memory available) or
+  // stopped when it ran past `time_limit_s`. `sc_last_error` names the limit, the
+  // estimate and what to do.
+  SC_STATUS_RESOURCE_LIMIT = 19,
   // An internal error (a bug in shapecorr): the call was stopped safely; please report
   // the message of `sc_last_error`.
   SC_STATUS_PANIC = 100,
@@ -336,7 +341,10 @@ const char *sc_last_error(void);
 // and parameters, whatever the number of threads.
 //
 // Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work),
-// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+// `SC_STATUS_RESOURCE_LIMIT` (the job's estimate exceeds `memory_limit_mib`,
+// `time_limit_s` or `max_vertices`, checked before any work, or it ran past
+// `time_limit_s`), `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback
+// returned false).
 //
 // # Safety
 // `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,
@@ -549,6 +557,13 @@ const char *sc_option_name(size_t index);
 // One-line description of option `index` (static), or NULL past the end.
 const char *sc_option_doc(size_t index);
 
+// Name of value `value` of option `index` when the option chooses among named
+// alternatives (`p2p_regions`: `"none"`, `"one-to-one"`, `"symmetric"`; `p2p_refinement`:
+// `"none"`, `"zoomout"`, `"icp"`), the name the command line also takes; static, never
+// free it. NULL when the option is not a choice, or past its last value or the last
+// option: values are numbered from 0, so a loop up to the first NULL lists them.
+const char *sc_option_choice(size_t index, size_t value);
+
 // Type of option `index`: `SC_OPTION_INT`, `SC_OPTION_DOUBLE` or `SC_OPTION_BOOL`;
 // `UINT32_MAX` past the end.
 uint32_t sc_option_type(size_t index);
@@ -570,7 +585,8 @@ double sc_option_max(size_t index);
 //
 // Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work, e.g. `p2p_fmap_size`
 // above `p2p_eigenpairs`, or no region constraint and no descriptor),
-// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+// `SC_STATUS_RESOURCE_LIMIT` (as `sc_match`), `SC_STATUS_NUMERICAL_FAILURE`,
+// `SC_STATUS_CANCELLED` (the callback returned false).
 //
 // # Safety
 // `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,

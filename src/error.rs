@@ -91,19 +91,34 @@ pub enum Error {
         /// Comma-separated list of the option names that exist.
         known: String,
     },
+    /// A job too big for a limit: refused before any work by its estimate, or stopped when
+    /// it ran past the limit. Not a bad value: the job may run with a higher limit, on
+    /// simpler shapes or on a larger machine (docs/design.md, "Errors and status codes").
+    #[error("resource limit `{limit}`: {reason}")]
+    ResourceLimit {
+        /// The limit: the option that sets it (`memory_limit_mib`, `time_limit_s`,
+        /// `max_vertices`), or `available_memory` for the memory the system can give.
+        limit: &'static str,
+        /// What the job needs (the estimate) or did, against the limit, and what to do.
+        reason: String,
+    },
 }
+
+/// The limits of a whole job rather than of one shape ([`Error::in_shape`]).
+const JOB_LIMITS: [&str; 2] = ["memory_limit_mib", "time_limit_s"];
 
 /// Result with the crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
     /// This error as one about shape `side` (`'A'` or `'B'`) of a pair. A cancel, a file
-    /// error (it names the file) and a parameter error other than `max_vertices` are not
-    /// about a shape and stay as they are.
+    /// error (it names the file), a parameter error and the limits of the whole job
+    /// (`memory_limit_mib`, `time_limit_s`) are not about a shape and stay as they are.
     pub fn in_shape(self, side: char) -> Error {
         match self {
             Error::Cancelled | Error::File { .. } | Error::InShape { .. } => self,
-            Error::InvalidParameter { name, .. } if name != "max_vertices" => self,
+            Error::InvalidParameter { .. } => self,
+            Error::ResourceLimit { limit, .. } if JOB_LIMITS.contains(&limit) => self,
             _ => Error::InShape {
                 side,
                 source: Box::new(self),

@@ -5,13 +5,16 @@
 //! same defaults, which come from `Params::default()` and `PointwiseParams::default()`.
 //! [`Options`] holds a value for every option.
 //!
-//! A value is type-checked and range-checked here as far as the option alone allows
-//! (integers non-negative and within range, choices among their listed values, floats
-//! finite); the checks that involve several options (`k_min <= k_max`,
-//! `p2p_fmap_size <= p2p_eigenpairs`) are [`Params::validate`]'s and
-//! [`PointwiseParams::validate`]'s. Text front ends (the command line, `--set NAME=VALUE`)
-//! read a value with [`parse_option_value`], which also knows the choices' names
-//! (`p2p_refinement = icp`).
+//! Each option is declared once, in [`OPTIONS`]: its name, description, range, choices and
+//! the field it reads and writes; getting, setting and checking by name all go through that
+//! entry. A value is type-checked and range-checked here as far as the option alone allows
+//! (integers within range, choices among their listed values, floats finite); the checks
+//! that involve several options (`k_min <= k_max`, `p2p_fmap_size <= p2p_eigenpairs`) are
+//! [`Params::validate`]'s and [`PointwiseParams::validate`]'s. Text front ends (the command
+//! line, `--set NAME=VALUE`) read a value with [`parse_option_value`], which also knows the
+//! choices' names (`p2p_refinement = icp`).
+
+use std::fmt;
 
 use crate::maps::fmap::ZoomOutParams;
 use crate::maps::pointwise::{PointwiseParams, Refinement, RegionConstraints};
@@ -76,14 +79,27 @@ pub struct OptionInfo {
     /// Smallest accepted value (integers and floats; 0 for a bool).
     pub min: f64,
     /// Largest accepted value: what the pipeline can do in memory and time (see
-    /// docs/decisions.md, "Option ranges").
+    /// docs/decisions.md, "Option ranges"; 1 for a bool).
     pub max: f64,
+    /// For an integer that chooses among named alternatives (`p2p_regions`,
+    /// `p2p_refinement`), their names by value (0, 1, ...); empty for other options.
+    pub choices: &'static [&'static str],
+    /// The field the option reads and writes.
+    access: Access,
 }
 
 impl OptionInfo {
     /// This option with the accepted range `[min, max]`.
     const fn range(self, min: f64, max: f64) -> OptionInfo {
         OptionInfo { min, max, ..self }
+    }
+
+    /// This integer option as a choice among `names`, by value (range `[0, n - 1]`).
+    const fn with_choices(self, names: &'static [&'static str]) -> OptionInfo {
+        OptionInfo {
+            choices: names,
+            ..self.range(0.0, (names.len() - 1) as f64)
+        }
     }
 
     /// The accepted range as text, e.g. `[1, 100]`.
@@ -101,25 +117,159 @@ fn number_text(v: f64) -> String {
     }
 }
 
-const fn info(name: &'static str, option_type: OptionType, doc: &'static str) -> OptionInfo {
-    OptionInfo {
-        name,
-        option_type,
-        group: OptionGroup::Regions,
-        doc,
-        min: 0.0,
-        max: 0.0,
+/// The choices as text: `none (0), zoomout (1), icp (2)`.
+fn choices_text(names: &[&str]) -> String {
+    let listed: Vec<String> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| format!("{n} ({i})"))
+        .collect();
+    listed.join(", ")
+}
+
+/// How an option reads and writes the parameters of type `T` that hold it: a getter and a
+/// setter of the option's type. The setter gets a value already checked against the
+/// option's range, so it only stores it.
+enum Field<T> {
+    Int(fn(&T) -> i64, fn(&mut T, i64)),
+    Float(fn(&T) -> f64, fn(&mut T, f64)),
+    Bool(fn(&T) -> bool, fn(&mut T, bool)),
+}
+
+// Function pointers are `Copy` whatever `T` is (a derive would ask `T: Copy`).
+impl<T> Clone for Field<T> {
+    fn clone(&self) -> Self {
+        *self
     }
 }
 
-const fn p2p(name: &'static str, option_type: OptionType, doc: &'static str) -> OptionInfo {
+impl<T> Copy for Field<T> {}
+
+impl<T> Field<T> {
+    const fn option_type(&self) -> OptionType {
+        match self {
+            Field::Int(..) => OptionType::Int,
+            Field::Float(..) => OptionType::Float,
+            Field::Bool(..) => OptionType::Bool,
+        }
+    }
+
+    /// The current value in `holder`.
+    fn read(self, holder: &T) -> OptionValue {
+        match self {
+            Field::Int(get, _) => OptionValue::Int(get(holder)),
+            Field::Float(get, _) => OptionValue::Float(get(holder)),
+            Field::Bool(get, _) => OptionValue::Bool(get(holder)),
+        }
+    }
+
+    /// Checks `value` (type and range of `info`) and stores it in `holder`; nothing changes
+    /// on error.
+    fn write(self, info: &OptionInfo, holder: &mut T, value: OptionValue) -> Result<()> {
+        match (self, value) {
+            (Field::Int(_, set), OptionValue::Int(v)) => set(holder, checked_int(info, v)?),
+            (Field::Float(_, set), OptionValue::Float(v)) => set(holder, checked_float(info, v)?),
+            (Field::Bool(_, set), OptionValue::Bool(v)) => set(holder, v),
+            _ => return Err(wrong_type(info, value.option_type())),
+        }
+        Ok(())
+    }
+}
+
+/// Which parameters hold an option, and its field there.
+#[derive(Clone, Copy)]
+enum Access {
+    /// A field of [`Params`].
+    Regions(Field<Params>),
+    /// A field of [`Options`] (the pointwise parameters and the refinements' settings).
+    Pointwise(Field<Options>),
+}
+
+impl fmt::Debug for Access {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Access::Regions(_) => "Params field",
+            Access::Pointwise(_) => "Options field",
+        })
+    }
+}
+
+/// An integer field set by an option: the option's `i64` and back. The value is in the
+/// option's range (non-negative but for `seed`, whose bits are kept), so nothing is lost.
+trait IntField {
+    fn to_option(self) -> i64;
+    fn from_option(value: i64) -> Self;
+}
+
+impl IntField for usize {
+    fn to_option(self) -> i64 {
+        self as i64
+    }
+    fn from_option(value: i64) -> Self {
+        value as usize
+    }
+}
+
+impl IntField for u64 {
+    fn to_option(self) -> i64 {
+        self as i64
+    }
+    fn from_option(value: i64) -> Self {
+        value as u64
+    }
+}
+
+/// The [`Field`] of the plain field `$($path).+` of `$holder`, of option type `Int`,
+/// `Float` or `Bool` (the field's Rust type must match: `usize`/`u64`, `f64`, `bool`).
+macro_rules! field {
+    ($holder:ty, Int, $($path:ident).+) => {
+        Field::Int(
+            |p: &$holder| IntField::to_option(p.$($path).+),
+            |p: &mut $holder, v| p.$($path).+ = IntField::from_option(v),
+        )
+    };
+    ($holder:ty, Float, $($path:ident).+) => {
+        Field::Float(|p: &$holder| p.$($path).+, |p: &mut $holder, v| p.$($path).+ = v)
+    };
+    ($holder:ty, Bool, $($path:ident).+) => {
+        Field::Bool(|p: &$holder| p.$($path).+, |p: &mut $holder, v| p.$($path).+ = v)
+    };
+}
+
+/// An option of the region correspondence ([`Params`]).
+const fn regions(name: &'static str, doc: &'static str, field: Field<Params>) -> OptionInfo {
+    entry(name, doc, OptionGroup::Regions, Access::Regions(field))
+}
+
+/// An option of the pointwise map (held by [`Options`]).
+const fn p2p(name: &'static str, doc: &'static str, field: Field<Options>) -> OptionInfo {
+    entry(name, doc, OptionGroup::Pointwise, Access::Pointwise(field))
+}
+
+const fn entry(
+    name: &'static str,
+    doc: &'static str,
+    group: OptionGroup,
+    access: Access,
+) -> OptionInfo {
+    let option_type = match &access {
+        Access::Regions(field) => field.option_type(),
+        Access::Pointwise(field) => field.option_type(),
+    };
     OptionInfo {
         name,
         option_type,
-        group: OptionGroup::Pointwise,
+        group,
         doc,
         min: 0.0,
-        max: 0.0,
+        // A bool is 0 or 1; integers and floats give their range.
+        max: if matches!(option_type, OptionType::Bool) {
+            1.0
+        } else {
+            0.0
+        },
+        choices: &[],
+        access,
     }
 }
 
@@ -148,235 +298,297 @@ pub const P2P_REFINEMENT_NAMES: [&str; 3] = ["none", "zoomout", "icp"];
 /// `icp`): the default of `p2p_icp_iterations`.
 pub const ICP_ITERATIONS: usize = 10;
 
-use OptionType::{Bool, Float, Int};
+/// The value of `p2p_regions` for `regions` (its index in [`P2P_REGIONS`]).
+fn regions_value(regions: &RegionConstraints) -> i64 {
+    match regions {
+        RegionConstraints::None => 0,
+        RegionConstraints::OneToOne => 1,
+        RegionConstraints::Symmetric => 2,
+    }
+}
 
 /// Every named option, in a stable order (new options are appended).
 pub const OPTIONS: &[OptionInfo] = &[
-    info(
+    regions(
         "k_min",
-        Int,
         "smallest number of joint clusters tried (paper: 5)",
+        field!(Params, Int, segmentation.k_min),
     )
     .range(2.0, 100.0),
-    info(
+    regions(
         "k_max",
-        Int,
         "largest number of joint clusters tried (paper: 10)",
+        field!(Params, Int, segmentation.k_max),
     )
     .range(2.0, 100.0),
-    info(
+    regions(
         "kmeans_restarts",
-        Int,
         "k-means++ starts per k; the lowest cost is kept",
+        field!(Params, Int, segmentation.kmeans_restarts),
     )
     .range(1.0, 1000.0),
-    info(
+    regions(
         "max_regions",
-        Int,
         "graphs with more regions than this are not accepted",
+        field!(Params, Int, segmentation.max_regions),
     )
     .range(1.0, 10_000.0),
-    info(
+    regions(
         "min_region_area",
-        Float,
         "regions below this fraction of the area are merged into a neighbour",
+        field!(Params, Float, segmentation.min_region_area),
     )
     .range(0.0, 0.49),
-    info(
+    // Any 64-bit value is a seed (a negative one is read as its unsigned bits), used by
+    // every random choice.
+    regions(
         "seed",
-        Int,
         "seed of every random choice (k-means++, eigensolver start, local search)",
+        Field::Int(
+            |p: &Params| p.segmentation.seed.to_option(),
+            |p: &mut Params, v| {
+                let seed = u64::from_option(v);
+                p.segmentation.seed = seed;
+                p.eigen.seed = seed;
+                p.symmetry.seed = seed;
+            },
+        ),
     )
     .range(i64::MIN as f64, u64::MAX as f64),
-    info("hks_times", Int, "number of heat kernel signature times").range(1.0, 100.0),
-    info("hks_t_min", Float, "smallest HKS time (unit-area shape)").range(1e-6, 1e3),
-    info("hks_t_max", Float, "largest HKS time (unit-area shape)").range(1e-6, 1e3),
-    info("hks_log", Bool, "use the logarithm of the HKS").range(0.0, 1.0),
-    info("eigenpairs", Int, "number of Laplacian eigenpairs").range(1.0, 1000.0),
-    info(
-        "threads",
-        Int,
-        "threads of the eigensolver (0: all cores); results do not depend on it",
+    regions(
+        "hks_times",
+        "number of heat kernel signature times",
+        field!(Params, Int, hks.n_times),
     )
-    .range(0.0, 1024.0),
-    info(
-        "sigma",
-        Float,
-        "width of the graph matching's Gaussian affinities",
+    .range(1.0, 100.0),
+    regions(
+        "hks_t_min",
+        "smallest HKS time (unit-area shape)",
+        field!(Params, Float, hks.t_min),
     )
-    .range(1e-3, 100.0),
-    info(
-        "histogram_bins",
-        Int,
-        "bins of the graph-distance histograms",
+    .range(1e-6, 1e3),
+    regions(
+        "hks_t_max",
+        "largest HKS time (unit-area shape)",
+        field!(Params, Float, hks.t_max),
+    )
+    .range(1e-6, 1e3),
+    regions(
+        "hks_log",
+        "use the logarithm of the HKS",
+        field!(Params, Bool, hks.log),
+    ),
+    regions(
+        "eigenpairs",
+        "number of Laplacian eigenpairs",
+        field!(Params, Int, eigen.n_eigenpairs),
     )
     .range(1.0, 1000.0),
-    info(
+    regions(
+        "threads",
+        "threads of the eigensolver (0: all cores); results do not depend on it",
+        field!(Params, Int, eigen.threads),
+    )
+    .range(0.0, 1024.0),
+    regions(
+        "sigma",
+        "width of the graph matching's Gaussian affinities",
+        field!(Params, Float, matching.sigma),
+    )
+    .range(1e-3, 100.0),
+    regions(
+        "histogram_bins",
+        "bins of the graph-distance histograms",
+        field!(Params, Int, matching.histogram_bins),
+    )
+    .range(1.0, 1000.0),
+    regions(
         "gap_ratio",
-        Float,
         "a match scoring below ratio x the previous one ends the list",
+        field!(Params, Float, matching.gap_ratio),
     )
     .range(0.0, 1.0),
-    info(
+    regions(
         "max_symmetry_order",
-        Int,
         "largest number of matches per region",
+        field!(Params, Int, matching.max_symmetry_order),
     )
     .range(1.0, 64.0),
-    info(
+    regions(
         "one_to_one",
-        Bool,
         "break symmetries into a one-to-one region correspondence",
-    )
-    .range(0.0, 1.0),
-    info(
+        Field::Bool(
+            |p: &Params| !p.skip_one_to_one,
+            |p: &mut Params, v| p.skip_one_to_one = !v,
+        ),
+    ),
+    regions(
         "exhaustive_limit",
-        Int,
         "one-to-one: largest number of combinations searched exhaustively",
+        field!(Params, Int, symmetry.exhaustive_limit),
     )
     .range(0.0, 10_000_000.0),
-    info(
+    regions(
         "symmetry_restarts",
-        Int,
         "one-to-one: local-search restarts above that limit",
+        field!(Params, Int, symmetry.restarts),
     )
     .range(0.0, 10_000.0),
-    info(
+    regions(
         "hks_fallback",
-        Bool,
         "second try with HKS from a smaller time when the first leaves area unmatched",
-    )
-    .range(0.0, 1.0),
+        Field::Bool(
+            |p: &Params| p.fallback.is_some(),
+            |p: &mut Params, v| p.fallback = v.then(|| p.fallback.clone().unwrap_or_default()),
+        ),
+    ),
     p2p(
         "p2p_eigenpairs",
-        Int,
         "pointwise map: Laplacian eigenpairs per shape (the largest basis any step uses)",
+        field!(Options, Int, pointwise.n_eigenpairs),
     )
     .range(2.0, 1000.0),
     p2p(
         "p2p_fmap_size",
-        Int,
         "pointwise map: size k of the first functional map (k x k)",
+        field!(Options, Int, pointwise.fmap_size),
     )
     .range(2.0, 1000.0),
     p2p(
         "p2p_regions",
-        Int,
         "pointwise map: region constraints: 0 none, 1 one-to-one (matches), 2 symmetric (groups)",
+        Field::Int(
+            |o: &Options| regions_value(&o.pointwise.regions),
+            |o: &mut Options, v| o.pointwise.regions = P2P_REGIONS[v as usize],
+        ),
     )
-    .range(0.0, 2.0),
+    .with_choices(&P2P_REGIONS_NAMES),
     p2p(
         "p2p_region_distances",
-        Bool,
         "pointwise map: also constrain by the distance from each matched region",
-    )
-    .range(0.0, 1.0),
+        field!(Options, Bool, pointwise.region_distances),
+    ),
     p2p(
         "p2p_wks",
-        Bool,
         "pointwise map: also constrain by wave kernel signatures (100 energies)",
-    )
-    .range(0.0, 1.0),
+        Field::Bool(
+            |o: &Options| o.pointwise.wks.is_some(),
+            |o: &mut Options, v| {
+                o.pointwise.wks = v.then(|| o.pointwise.wks.clone().unwrap_or_default())
+            },
+        ),
+    ),
     p2p(
         "p2p_descriptor_step",
-        Int,
         "pointwise map: keep every n-th WKS energy",
+        field!(Options, Int, pointwise.descriptor_step),
     )
     .range(1.0, 100.0),
     p2p(
         "p2p_laplacian_weight",
-        Float,
         "pointwise map: weight of the Laplacian commutativity term",
+        field!(Options, Float, pointwise.laplacian_weight),
     )
     .range(0.0, 1e6),
     p2p(
         "p2p_descriptor_commutativity",
-        Float,
         "pointwise map: weight of the descriptor commutativity term (0 = off)",
+        field!(Options, Float, pointwise.descriptor_commutativity),
     )
     .range(0.0, 1e6),
     p2p(
         "p2p_orientation_term",
-        Float,
         "pointwise map: weight of the orientation-preserving term (0 = off)",
+        field!(Options, Float, pointwise.orientation_term),
     )
     .range(0.0, 1e6),
+    // The refinements' settings are kept apart from the choice ([`Options`]).
     p2p(
         "p2p_refinement",
-        Int,
         "pointwise map: refinement: 0 none, 1 zoomout (ZoomOut), 2 icp (spectral ICP)",
+        Field::Int(
+            |o: &Options| match o.pointwise.refinement {
+                Refinement::None => P2P_REFINEMENT_NONE,
+                Refinement::ZoomOut(_) => P2P_REFINEMENT_ZOOMOUT,
+                Refinement::Icp(_) => P2P_REFINEMENT_ICP,
+            },
+            |o: &mut Options, v| {
+                o.pointwise.refinement = match v {
+                    P2P_REFINEMENT_NONE => Refinement::None,
+                    P2P_REFINEMENT_ZOOMOUT => Refinement::ZoomOut(o.zoomout.clone()),
+                    _ => Refinement::Icp(o.icp_iterations),
+                }
+            },
+        ),
     )
-    .range(0.0, 2.0),
+    .with_choices(&P2P_REFINEMENT_NAMES),
     p2p(
         "p2p_zoomout_end",
-        Int,
         "pointwise map: ZoomOut's final basis size (at most p2p_eigenpairs)",
+        field!(Options, Int, zoomout.k_end),
     )
     .range(1.0, 1000.0),
     p2p(
         "p2p_zoomout_step",
-        Int,
         "pointwise map: eigenfunctions ZoomOut adds per iteration",
+        field!(Options, Int, zoomout.step),
     )
     .range(1.0, 1000.0),
     p2p(
         "p2p_zoomout_sample",
-        Int,
         "pointwise map: vertices per shape ZoomOut iterates on (0: all)",
+        field!(Options, Int, zoomout.sample_size),
     )
     .range(0.0, 100_000_000.0),
     p2p(
         "p2p_icp_iterations",
-        Int,
         "pointwise map: largest number of spectral ICP iterations",
+        field!(Options, Int, icp_iterations),
     )
     .range(0.0, 1000.0),
     p2p(
         "p2p_orientation",
-        Bool,
         "pointwise map: verify the answer's mirror image as a hypothesis (orientable meshes)",
-    )
-    .range(0.0, 1.0),
+        field!(Options, Bool, pointwise.orientation),
+    ),
     p2p(
         "p2p_hypotheses",
-        Bool,
         "pointwise map: verify the symmetric groups and single-group alternatives as hypotheses",
-    )
-    .range(0.0, 1.0),
-    info(
+        field!(Options, Bool, pointwise.hypotheses),
+    ),
+    regions(
         "verify_hypotheses",
-        Bool,
         "regions: choose among one-to-one hypotheses by their refined maps (and give a confidence)",
-    )
-    .range(0.0, 1.0),
-    info(
+        field!(Params, Bool, verify_hypotheses),
+    ),
+    regions(
         "proxy_above",
-        Int,
         "dense shapes: a shape with more vertices runs on a proxy of about proxy_vertices (0: never)",
+        field!(Params, Int, multiresolution.above),
     )
     .range(0.0, 100_000_000.0),
-    info(
+    regions(
         "proxy_vertices",
-        Int,
         "dense shapes: about how many vertices a proxy has (64 or more, below proxy_above)",
+        field!(Params, Int, multiresolution.proxy_vertices),
     )
     .range(64.0, 100_000_000.0),
-    info(
+    regions(
         "max_vertices",
-        Int,
         "largest shape accepted, in vertices; a larger one is refused before any work",
+        field!(Params, Int, eigen.max_vertices),
     )
     .range(32.0, 100_000_000.0),
-    info(
+    regions(
         "memory_limit_mib",
-        Int,
         "memory ceiling of a job in MiB (0: the memory available); a job estimated above it is refused before any work",
+        field!(Params, Int, budget.memory_limit_mib),
     )
     .range(0.0, 16_777_216.0),
-    info(
+    regions(
         "time_limit_s",
-        Float,
         "time limit of a job in seconds (0: none); refused at once when estimated above it, stopped when it runs past it",
+        field!(Params, Float, budget.time_limit_s),
     )
     .range(0.0, 1e7),
 ];
@@ -396,14 +608,13 @@ pub fn option_info(name: &str) -> Result<&'static OptionInfo> {
         })
 }
 
-/// The names of the choices of option `name`, by value (`p2p_regions`, `p2p_refinement`);
-/// `None` for an option that is not a choice.
+/// The names of the choices of option `name`, by value (`p2p_regions`, `p2p_refinement`;
+/// [`OptionInfo::choices`]); `None` for an option that is not a choice.
 pub fn option_choices(name: &str) -> Option<&'static [&'static str]> {
-    match name {
-        "p2p_regions" => Some(&P2P_REGIONS_NAMES),
-        "p2p_refinement" => Some(&P2P_REFINEMENT_NAMES),
-        _ => None,
-    }
+    option_info(name)
+        .ok()
+        .map(|info| info.choices)
+        .filter(|choices| !choices.is_empty())
 }
 
 /// Reads a value of option `name` from text, by the option's type: an integer (a choice
@@ -416,20 +627,21 @@ pub fn parse_option_value(name: &str, text: &str) -> Result<OptionValue> {
     let info = option_info(name)?;
     let trimmed = text.trim();
     let lower = trimmed.to_ascii_lowercase();
+    // An option whose range reaches past i64 (`seed`) also takes unsigned 64-bit text.
+    let unsigned = info.max > i64::MAX as f64;
     let parsed = match info.option_type {
-        OptionType::Int => match option_choices(info.name) {
-            Some(names) => names
-                .iter()
-                .position(|n| *n == lower)
-                .map(|i| i as i64)
-                .or_else(|| trimmed.parse().ok()),
-            None if info.name == "seed" => trimmed
-                .parse()
-                .ok()
-                .or_else(|| trimmed.parse::<u64>().ok().map(|v| v as i64)),
-            None => trimmed.parse().ok(),
-        }
-        .map(OptionValue::Int),
+        OptionType::Int => info
+            .choices
+            .iter()
+            .position(|n| *n == lower)
+            .map(|i| i as i64)
+            .or_else(|| trimmed.parse().ok())
+            .or_else(|| {
+                unsigned
+                    .then(|| trimmed.parse::<u64>().ok().map(|v| v as i64))
+                    .flatten()
+            })
+            .map(OptionValue::Int),
         OptionType::Float => trimmed.parse().ok().map(OptionValue::Float),
         OptionType::Bool => match lower.as_str() {
             "true" | "yes" | "1" => Some(OptionValue::Bool(true)),
@@ -438,18 +650,13 @@ pub fn parse_option_value(name: &str, text: &str) -> Result<OptionValue> {
         },
     };
     parsed.ok_or_else(|| {
-        let expected = match (info.option_type, option_choices(info.name)) {
-            (OptionType::Int, Some(names)) => {
-                let listed: Vec<String> = names
-                    .iter()
-                    .enumerate()
-                    .map(|(i, n)| format!("{n} ({i})"))
-                    .collect();
-                format!("one of {}", listed.join(", "))
+        let expected = match info.option_type {
+            OptionType::Int if !info.choices.is_empty() => {
+                format!("one of {}", choices_text(info.choices))
             }
-            (OptionType::Int, None) => "an integer".to_string(),
-            (OptionType::Float, _) => "a number".to_string(),
-            (OptionType::Bool, _) => "true or false (yes/no, 1/0)".to_string(),
+            OptionType::Int => "an integer".to_string(),
+            OptionType::Float => "a number".to_string(),
+            OptionType::Bool => "true or false (yes/no, 1/0)".to_string(),
         };
         Error::InvalidParameter {
             name: info.name,
@@ -472,17 +679,23 @@ fn out_of_range(info: &OptionInfo, value: impl std::fmt::Display) -> Error {
     }
 }
 
-/// An integer within the option's range.
-fn to_usize(info: &OptionInfo, value: i64) -> Result<usize> {
-    let in_range = (info.min..=info.max).contains(&(value as f64));
-    match usize::try_from(value) {
-        Ok(v) if in_range => Ok(v),
-        _ => Err(out_of_range(info, value)),
+/// An integer within the option's range (a choice: one of its values).
+fn checked_int(info: &OptionInfo, value: i64) -> Result<i64> {
+    if !info.choices.is_empty() && usize::try_from(value).map_or(true, |v| v >= info.choices.len())
+    {
+        return Err(Error::InvalidParameter {
+            name: info.name,
+            reason: format!("must be one of {}, got {value}", choices_text(info.choices)),
+        });
     }
+    if !(info.min..=info.max).contains(&(value as f64)) {
+        return Err(out_of_range(info, value));
+    }
+    Ok(value)
 }
 
 /// A finite float within the option's range.
-fn to_finite(info: &OptionInfo, value: f64) -> Result<f64> {
+fn checked_float(info: &OptionInfo, value: f64) -> Result<f64> {
     if !value.is_finite() {
         return Err(Error::InvalidParameter {
             name: info.name,
@@ -495,151 +708,54 @@ fn to_finite(info: &OptionInfo, value: f64) -> Result<f64> {
     Ok(value)
 }
 
-/// The option called `name`, of type `value` (if given) and of `group`.
-fn checked_info(
-    name: &str,
-    value: Option<OptionValue>,
-    group: OptionGroup,
-) -> Result<&'static OptionInfo> {
-    let info = option_info(name)?;
-    if info.group != group {
-        let holder = match info.group {
-            OptionGroup::Regions => "Params",
-            OptionGroup::Pointwise => "PointwiseParams",
-        };
-        return Err(Error::InvalidParameter {
-            name: info.name,
-            reason: format!("belongs to {holder}; set and read it through options::Options"),
-        });
-    }
+/// Checks that a value read from the parameters lies in the option's range (for values set
+/// directly in the parameter structs, which `set_option` did not see).
+fn check_range(info: &OptionInfo, value: OptionValue) -> Result<()> {
     match value {
-        Some(v) if v.option_type() != info.option_type => Err(wrong_type(info, v.option_type())),
-        _ => Ok(info),
+        OptionValue::Int(v) => checked_int(info, v).map(drop),
+        OptionValue::Float(v) => checked_float(info, v).map(drop),
+        OptionValue::Bool(_) => Ok(()),
     }
 }
 
-/// Checks that every option of `group` read by `value_of` lies in its range (for values
-/// set directly in the parameter structs, which [`Params::set_option`] did not see).
-fn check_ranges(group: OptionGroup, value_of: impl Fn(&str) -> Result<OptionValue>) -> Result<()> {
-    for info in OPTIONS
-        .iter()
-        .filter(|o| o.group == group && o.name != "seed")
-    {
-        match value_of(info.name)? {
-            OptionValue::Int(v) => {
-                to_usize(info, v)?;
-            }
-            OptionValue::Float(v) => {
-                to_finite(info, v)?;
-            }
-            OptionValue::Bool(_) => {}
-        }
+/// The error for an option of the pointwise map asked of [`Params`] alone.
+fn held_by_options(info: &OptionInfo) -> Error {
+    Error::InvalidParameter {
+        name: info.name,
+        reason: "belongs to PointwiseParams; set and read it through options::Options".to_string(),
     }
-    Ok(())
 }
 
 impl Params {
     /// Checks that every option's value lies in its documented range
     /// ([`OptionInfo::min`], [`OptionInfo::max`]); called by [`Params::validate`].
     pub fn check_option_ranges(&self) -> Result<()> {
-        check_ranges(OptionGroup::Regions, |name| self.option(name))
+        OPTIONS.iter().try_for_each(|info| match info.access {
+            Access::Regions(field) => check_range(info, field.read(self)),
+            Access::Pointwise(_) => Ok(()),
+        })
     }
 
     /// Sets the option `name` (one of [`OptionGroup::Regions`]). Errors with
     /// [`Error::UnknownOption`] for a name not in [`OPTIONS`], and with
     /// [`Error::InvalidParameter`] for a pointwise option (see [`Options`]), a value of the
-    /// wrong type, a negative integer or a non-finite float. Nothing changes on error.
+    /// wrong type or out of the option's range. Nothing changes on error.
     pub fn set_option(&mut self, name: &str, value: OptionValue) -> Result<()> {
-        let info = checked_info(name, Some(value), OptionGroup::Regions)?;
-        match value {
-            OptionValue::Int(v) => {
-                // Seeds take the full 64 bits (reinterpreted), so any integer is a seed.
-                if info.name == "seed" {
-                    let seed = v as u64;
-                    self.segmentation.seed = seed;
-                    self.eigen.seed = seed;
-                    self.symmetry.seed = seed;
-                    return Ok(());
-                }
-                let v = to_usize(info, v)?;
-                match info.name {
-                    "k_min" => self.segmentation.k_min = v,
-                    "k_max" => self.segmentation.k_max = v,
-                    "kmeans_restarts" => self.segmentation.kmeans_restarts = v,
-                    "max_regions" => self.segmentation.max_regions = v,
-                    "hks_times" => self.hks.n_times = v,
-                    "eigenpairs" => self.eigen.n_eigenpairs = v,
-                    "threads" => self.eigen.threads = v,
-                    "histogram_bins" => self.matching.histogram_bins = v,
-                    "max_symmetry_order" => self.matching.max_symmetry_order = v,
-                    "exhaustive_limit" => self.symmetry.exhaustive_limit = v,
-                    "symmetry_restarts" => self.symmetry.restarts = v,
-                    "max_vertices" => self.eigen.max_vertices = v,
-                    "proxy_above" => self.multiresolution.above = v,
-                    "proxy_vertices" => self.multiresolution.proxy_vertices = v,
-                    "memory_limit_mib" => self.budget.memory_limit_mib = v as u64,
-                    other => unreachable!("integer option {other} has no field"),
-                }
-            }
-            OptionValue::Float(v) => {
-                let v = to_finite(info, v)?;
-                match info.name {
-                    "min_region_area" => self.segmentation.min_region_area = v,
-                    "hks_t_min" => self.hks.t_min = v,
-                    "hks_t_max" => self.hks.t_max = v,
-                    "sigma" => self.matching.sigma = v,
-                    "gap_ratio" => self.matching.gap_ratio = v,
-                    "time_limit_s" => self.budget.time_limit_s = v,
-                    other => unreachable!("float option {other} has no field"),
-                }
-            }
-            OptionValue::Bool(v) => match info.name {
-                "hks_log" => self.hks.log = v,
-                "one_to_one" => self.skip_one_to_one = !v,
-                "hks_fallback" => {
-                    self.fallback = v.then(|| self.fallback.clone().unwrap_or_default())
-                }
-                "verify_hypotheses" => self.verify_hypotheses = v,
-                other => unreachable!("bool option {other} has no field"),
-            },
+        let info = option_info(name)?;
+        match info.access {
+            Access::Regions(field) => field.write(info, self, value),
+            Access::Pointwise(_) => Err(held_by_options(info)),
         }
-        Ok(())
     }
 
     /// The current value of the option `name` ([`Error::UnknownOption`] if there is none,
     /// [`Error::InvalidParameter`] for a pointwise option).
     pub fn option(&self, name: &str) -> Result<OptionValue> {
-        let info = checked_info(name, None, OptionGroup::Regions)?;
-        let int = |v: usize| OptionValue::Int(v as i64);
-        Ok(match info.name {
-            "k_min" => int(self.segmentation.k_min),
-            "k_max" => int(self.segmentation.k_max),
-            "kmeans_restarts" => int(self.segmentation.kmeans_restarts),
-            "max_regions" => int(self.segmentation.max_regions),
-            "min_region_area" => OptionValue::Float(self.segmentation.min_region_area),
-            "seed" => OptionValue::Int(self.segmentation.seed as i64),
-            "hks_times" => int(self.hks.n_times),
-            "hks_t_min" => OptionValue::Float(self.hks.t_min),
-            "hks_t_max" => OptionValue::Float(self.hks.t_max),
-            "hks_log" => OptionValue::Bool(self.hks.log),
-            "eigenpairs" => int(self.eigen.n_eigenpairs),
-            "threads" => int(self.eigen.threads),
-            "sigma" => OptionValue::Float(self.matching.sigma),
-            "histogram_bins" => int(self.matching.histogram_bins),
-            "gap_ratio" => OptionValue::Float(self.matching.gap_ratio),
-            "max_symmetry_order" => int(self.matching.max_symmetry_order),
-            "one_to_one" => OptionValue::Bool(!self.skip_one_to_one),
-            "exhaustive_limit" => int(self.symmetry.exhaustive_limit),
-            "symmetry_restarts" => int(self.symmetry.restarts),
-            "hks_fallback" => OptionValue::Bool(self.fallback.is_some()),
-            "verify_hypotheses" => OptionValue::Bool(self.verify_hypotheses),
-            "max_vertices" => int(self.eigen.max_vertices),
-            "proxy_above" => int(self.multiresolution.above),
-            "proxy_vertices" => int(self.multiresolution.proxy_vertices),
-            "memory_limit_mib" => int(self.budget.memory_limit_mib as usize),
-            "time_limit_s" => OptionValue::Float(self.budget.time_limit_s),
-            other => unreachable!("option {other} has no field"),
-        })
+        let info = option_info(name)?;
+        match info.access {
+            Access::Regions(field) => Ok(field.read(self)),
+            Access::Pointwise(_) => Err(held_by_options(info)),
+        }
     }
 }
 
@@ -697,7 +813,10 @@ impl Options {
     /// Checks both sets of parameters ([`Params::validate`], [`PointwiseParams::validate`]).
     pub fn validate(&self) -> Result<()> {
         self.params.validate()?;
-        check_ranges(OptionGroup::Pointwise, |name| self.option(name))?;
+        OPTIONS.iter().try_for_each(|info| match info.access {
+            Access::Regions(_) => Ok(()),
+            Access::Pointwise(field) => check_range(info, field.read(self)),
+        })?;
         self.pointwise.validate()
     }
 
@@ -705,111 +824,27 @@ impl Options {
     /// [`Error::InvalidParameter`] for a choice out of its list. Nothing changes on error.
     pub fn set_option(&mut self, name: &str, value: OptionValue) -> Result<()> {
         let info = option_info(name)?;
-        if info.group == OptionGroup::Regions {
-            return self.params.set_option(name, value);
-        }
-        let info = checked_info(name, Some(value), OptionGroup::Pointwise)?;
-        let p = &mut self.pointwise;
-        match value {
-            OptionValue::Int(v) => {
-                let choice = |n: usize| -> Result<usize> {
-                    usize::try_from(v).ok().filter(|&i| i < n).ok_or_else(|| {
-                        Error::InvalidParameter {
-                            name: info.name,
-                            reason: format!("must be one of 0 to {}, got {v}", n - 1),
-                        }
-                    })
-                };
-                match info.name {
-                    "p2p_regions" => p.regions = P2P_REGIONS[choice(P2P_REGIONS.len())?],
-                    "p2p_refinement" => {
-                        p.refinement = match choice(3)? as i64 {
-                            P2P_REFINEMENT_NONE => Refinement::None,
-                            P2P_REFINEMENT_ZOOMOUT => Refinement::ZoomOut(self.zoomout.clone()),
-                            _ => Refinement::Icp(self.icp_iterations),
-                        }
-                    }
-                    _ => {
-                        let v = to_usize(info, v)?;
-                        match info.name {
-                            "p2p_eigenpairs" => p.n_eigenpairs = v,
-                            "p2p_fmap_size" => p.fmap_size = v,
-                            "p2p_descriptor_step" => p.descriptor_step = v,
-                            "p2p_zoomout_end" => self.zoomout.k_end = v,
-                            "p2p_zoomout_step" => self.zoomout.step = v,
-                            "p2p_zoomout_sample" => self.zoomout.sample_size = v,
-                            "p2p_icp_iterations" => self.icp_iterations = v,
-                            other => unreachable!("integer option {other} has no field"),
-                        }
-                        // Keep the chosen refinement's settings current.
-                        match &mut p.refinement {
-                            Refinement::ZoomOut(z) => *z = self.zoomout.clone(),
-                            Refinement::Icp(n) => *n = self.icp_iterations,
-                            Refinement::None => {}
-                        }
-                    }
+        match info.access {
+            Access::Regions(field) => field.write(info, &mut self.params, value),
+            Access::Pointwise(field) => {
+                field.write(info, self, value)?;
+                // Keep the chosen refinement's settings current.
+                match &mut self.pointwise.refinement {
+                    Refinement::ZoomOut(z) => *z = self.zoomout.clone(),
+                    Refinement::Icp(n) => *n = self.icp_iterations,
+                    Refinement::None => {}
                 }
+                Ok(())
             }
-            OptionValue::Float(v) => {
-                // Every pointwise float option is a weight.
-                let v = to_finite(info, v)?;
-                if v < 0.0 {
-                    return Err(Error::InvalidParameter {
-                        name: info.name,
-                        reason: format!("a weight must be >= 0, got {v}"),
-                    });
-                }
-                match info.name {
-                    "p2p_laplacian_weight" => p.laplacian_weight = v,
-                    "p2p_descriptor_commutativity" => p.descriptor_commutativity = v,
-                    "p2p_orientation_term" => p.orientation_term = v,
-                    other => unreachable!("float option {other} has no field"),
-                }
-            }
-            OptionValue::Bool(v) => match info.name {
-                "p2p_region_distances" => p.region_distances = v,
-                "p2p_wks" => p.wks = v.then(|| p.wks.clone().unwrap_or_default()),
-                "p2p_orientation" => p.orientation = v,
-                "p2p_hypotheses" => p.hypotheses = v,
-                other => unreachable!("bool option {other} has no field"),
-            },
         }
-        Ok(())
     }
 
     /// The current value of any option ([`Error::UnknownOption`] if there is none).
     pub fn option(&self, name: &str) -> Result<OptionValue> {
         let info = option_info(name)?;
-        if info.group == OptionGroup::Regions {
-            return self.params.option(name);
-        }
-        let p = &self.pointwise;
-        let int = |v: usize| OptionValue::Int(v as i64);
-        Ok(match info.name {
-            "p2p_eigenpairs" => int(p.n_eigenpairs),
-            "p2p_fmap_size" => int(p.fmap_size),
-            "p2p_regions" => int(P2P_REGIONS
-                .iter()
-                .position(|r| *r == p.regions)
-                .expect("every region constraint has a value")),
-            "p2p_region_distances" => OptionValue::Bool(p.region_distances),
-            "p2p_wks" => OptionValue::Bool(p.wks.is_some()),
-            "p2p_descriptor_step" => int(p.descriptor_step),
-            "p2p_laplacian_weight" => OptionValue::Float(p.laplacian_weight),
-            "p2p_descriptor_commutativity" => OptionValue::Float(p.descriptor_commutativity),
-            "p2p_orientation_term" => OptionValue::Float(p.orientation_term),
-            "p2p_refinement" => OptionValue::Int(match p.refinement {
-                Refinement::None => P2P_REFINEMENT_NONE,
-                Refinement::ZoomOut(_) => P2P_REFINEMENT_ZOOMOUT,
-                Refinement::Icp(_) => P2P_REFINEMENT_ICP,
-            }),
-            "p2p_zoomout_end" => int(self.zoomout.k_end),
-            "p2p_zoomout_step" => int(self.zoomout.step),
-            "p2p_zoomout_sample" => int(self.zoomout.sample_size),
-            "p2p_icp_iterations" => int(self.icp_iterations),
-            "p2p_orientation" => OptionValue::Bool(p.orientation),
-            "p2p_hypotheses" => OptionValue::Bool(p.hypotheses),
-            other => unreachable!("option {other} has no field"),
+        Ok(match info.access {
+            Access::Regions(field) => field.read(&self.params),
+            Access::Pointwise(field) => field.read(self),
         })
     }
 }
@@ -825,11 +860,11 @@ mod tests {
             let mut options = Options::default();
             let value = match info.option_type {
                 // Choices take a valid value other than the default.
-                OptionType::Int if matches!(info.name, "p2p_regions" | "p2p_refinement") => {
+                OptionType::Int if !info.choices.is_empty() => {
                     let OptionValue::Int(v) = options.option(info.name).unwrap() else {
                         panic!("{} is not an integer", info.name)
                     };
-                    OptionValue::Int((v + 1) % 3)
+                    OptionValue::Int((v + 1) % info.choices.len() as i64)
                 }
                 OptionType::Int => {
                     OptionValue::Int((info.min as i64 + 1 + i as i64).min(info.max as i64))
@@ -1056,6 +1091,37 @@ mod tests {
     }
 
     #[test]
+    fn choices_are_declared_in_the_table_with_their_range() {
+        let choices: Vec<(&str, &[&str])> = OPTIONS
+            .iter()
+            .filter(|o| !o.choices.is_empty())
+            .map(|o| (o.name, o.choices))
+            .collect();
+        assert_eq!(
+            choices,
+            [
+                ("p2p_regions", &P2P_REGIONS_NAMES[..]),
+                ("p2p_refinement", &P2P_REFINEMENT_NAMES[..])
+            ]
+        );
+        for info in OPTIONS.iter().filter(|o| !o.choices.is_empty()) {
+            assert_eq!(info.option_type, OptionType::Int);
+            assert_eq!((info.min, info.max), (0.0, info.choices.len() as f64 - 1.0));
+            let err = Options::default()
+                .set_option(info.name, OptionValue::Int(info.choices.len() as i64))
+                .unwrap_err();
+            assert!(
+                err.to_string()
+                    .contains(&format!("{} (0)", info.choices[0])),
+                "{err}"
+            );
+        }
+        for info in OPTIONS.iter().filter(|o| o.option_type == OptionType::Bool) {
+            assert_eq!((info.min, info.max), (0.0, 1.0), "{}", info.name);
+        }
+    }
+
+    #[test]
     fn bad_text_says_what_was_expected() {
         let reason = |name: &str, text: &str| match parse_option_value(name, text) {
             Err(Error::InvalidParameter { name: n, reason }) => {
@@ -1083,7 +1149,10 @@ mod tests {
     #[test]
     fn orientation_is_the_pointwise_params_switch() {
         let last = OPTIONS.last().unwrap();
-        assert_eq!((last.name, last.option_type), ("time_limit_s", Float));
+        assert_eq!(
+            (last.name, last.option_type),
+            ("time_limit_s", OptionType::Float)
+        );
         assert!(Options::default().pointwise().hypotheses);
         let mut options = Options::default();
         assert_eq!(

@@ -12,6 +12,7 @@ fn humanoid(pose: usize, vertices: usize, proportions: Proportions) -> FigureMes
         pose,
         target_vertices: vertices,
         proportions,
+        ..Default::default()
     })
     .unwrap()
 }
@@ -82,6 +83,7 @@ fn other_proportions_and_a_noisy_point_cloud_still_match() {
         Proportions {
             limb_length: 1.15,
             limb_thickness: 0.85,
+            ..Default::default()
         },
     );
     let cloud = synth::sample_points(&other, 5000, 0.005, 7).unwrap();

@@ -142,6 +142,7 @@ fn hard_generated_pairs_keep_their_parts() {
     let longer = Proportions {
         limb_length: 1.25,
         limb_thickness: 0.9,
+        ..Default::default()
     };
     let cases: [(&str, FigureKind, Side, Side); 3] = [
         // Walking: front and back legs apart, of one length.

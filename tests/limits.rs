@@ -2,7 +2,7 @@
 //! "Budget"): every option has a range checked before any
 //! work, a huge but accepted value is cancellable within a fraction of a second, and a
 //! shape above `max_vertices` is refused at once, as is a job over its memory ceiling or
-//! time limit.
+//! time limit: with `Error::ResourceLimit`, not the error of a bad value.
 
 use std::time::{Duration, Instant};
 
@@ -164,8 +164,8 @@ fn a_shape_above_max_vertices_is_refused_before_any_work() {
     assert!(
         matches!(
             err,
-            Error::InvalidParameter {
-                name: "max_vertices",
+            Error::ResourceLimit {
+                limit: "max_vertices",
                 ..
             }
         ),
@@ -206,8 +206,8 @@ fn an_error_about_one_shape_of_a_pair_names_it() {
     assert!(matches!(err, Error::InShape { side: 'B', .. }), "{err}");
     assert!(matches!(
         err.innermost(),
-        Error::InvalidParameter {
-            name: "max_vertices",
+        Error::ResourceLimit {
+            limit: "max_vertices",
             ..
         }
     ));
@@ -383,7 +383,7 @@ fn a_two_million_vertex_pair_is_refused_at_once_by_the_default_budget() {
     assert!(started.elapsed().as_secs_f64() < 1.0);
     assert!(
         err.to_string()
-            .contains("invalid parameter `max_vertices`: the shape has 2002225 vertices"),
+            .contains("resource limit `max_vertices`: the shape has 2002225 vertices"),
         "{err}"
     );
     for (memory_limit_mib, refused_by) in [(0, None), (16_777_216, Some("time_limit_s"))] {
@@ -405,7 +405,7 @@ fn a_two_million_vertex_pair_is_refused_at_once_by_the_default_budget() {
         let err = result.unwrap_err();
         println!("memory_limit_mib {memory_limit_mib}: {seconds:.3} s: {err}");
         assert!(seconds < 1.0, "took {seconds:.2} s to refuse");
-        let Error::InvalidParameter { name, .. } = &err else {
+        let Error::ResourceLimit { limit: name, .. } = &err else {
             panic!("{err}")
         };
         assert!(
@@ -438,12 +438,64 @@ fn a_job_that_runs_past_its_time_limit_stops_there() {
     assert!(
         matches!(
             result,
-            Err(Error::InvalidParameter {
-                name: "time_limit_s",
+            Err(Error::ResourceLimit {
+                limit: "time_limit_s",
                 ..
             })
         ),
         "{result:?}"
     );
     assert!(seconds < 2.5, "stopped after {seconds:.2} s");
+}
+
+/// A job refused by the memory ceiling is a resource limit, not a bad value: every job
+/// (regions, symmetry, pointwise map) on two small shapes with `memory_limit_mib = 1` is
+/// refused at once with `Error::ResourceLimit` naming the limit, the estimate and what to
+/// do, while a value out of the option's range stays `Error::InvalidParameter`.
+#[test]
+fn a_job_over_the_memory_ceiling_is_refused_with_a_resource_limit() {
+    let a = humanoid(0, 700);
+    let b = humanoid(3, 700);
+    let mut options = Options::default();
+    options
+        .set_option("memory_limit_mib", OptionValue::Int(1))
+        .unwrap();
+    let started = Instant::now();
+    let results = [
+        shapecorr::Correspondence::compute(&a, &b, &options.params, &mut shapecorr::NoProgress)
+            .map(drop),
+        shapecorr::Symmetry::detect(&a, &options.params, &mut shapecorr::NoProgress).map(drop),
+        PointwiseCorrespondence::compute(
+            &a,
+            &b,
+            &options.params,
+            options.pointwise(),
+            &mut shapecorr::NoProgress,
+        )
+        .map(drop),
+    ];
+    assert!(started.elapsed() < Duration::from_millis(500));
+    for result in results {
+        let err = result.unwrap_err();
+        let Error::ResourceLimit { limit, reason } = &err else {
+            panic!("expected a resource limit, got {err:?}")
+        };
+        assert_eq!(*limit, "memory_limit_mib");
+        assert!(reason.contains("needs about"), "{reason}");
+        assert!(reason.contains("ceiling of 1 MiB"), "{reason}");
+        assert!(reason.contains("raise memory_limit_mib"), "{reason}");
+        assert!(
+            err.to_string()
+                .starts_with("resource limit `memory_limit_mib`: "),
+            "{err}"
+        );
+    }
+    // The same option out of its range is a bad value.
+    assert!(matches!(
+        options.set_option("memory_limit_mib", OptionValue::Int(-1)),
+        Err(Error::InvalidParameter {
+            name: "memory_limit_mib",
+            ..
+        })
+    ));
 }

@@ -41,6 +41,7 @@ fn on_proxies(proxy_vertices: usize) -> Params {
         multiresolution: Multiresolution {
             above: 2 * proxy_vertices,
             proxy_vertices,
+            ..Default::default()
         },
         ..Params::default()
     }
@@ -116,6 +117,7 @@ fn proxy_sizes_are_checked() {
         multiresolution: Multiresolution {
             above: 1_000,
             proxy_vertices: 1_000,
+            ..Default::default()
         },
         ..Params::default()
     };

@@ -23,6 +23,7 @@ fn humanoid(pose: usize, vertices: usize) -> FigureMesh {
         pose,
         target_vertices: vertices,
         proportions: Proportions::default(),
+        ..Default::default()
     })
     .unwrap()
 }

@@ -322,6 +322,7 @@ fn spec(kind: FigureKind, pose: usize, target: usize) -> FigureSpec {
         pose,
         target_vertices: target,
         proportions: Proportions::default(),
+        ..Default::default()
     }
 }
 
@@ -476,6 +477,7 @@ fn proportions_deform_the_same_mesh() {
             proportions: Proportions {
                 limb_length,
                 limb_thickness,
+                ..Default::default()
             },
             ..spec(FigureKind::Humanoid, pose, 3000)
         })
@@ -576,6 +578,7 @@ fn figures_are_deterministic() {
             proportions: Proportions {
                 limb_length: 1.1,
                 limb_thickness: 0.9,
+                ..Default::default()
             },
             ..spec(kind, 2, 3000)
         };
@@ -704,6 +707,7 @@ fn invalid_specs_are_rejected() {
             proportions: Proportions {
                 limb_length: 0.0,
                 limb_thickness: 1.0,
+                ..Default::default()
             },
             ..ok
         },
@@ -711,6 +715,7 @@ fn invalid_specs_are_rejected() {
             proportions: Proportions {
                 limb_length: 1.0,
                 limb_thickness: -1.0,
+                ..Default::default()
             },
             ..ok
         },
@@ -718,6 +723,7 @@ fn invalid_specs_are_rejected() {
             proportions: Proportions {
                 limb_length: f64::NAN,
                 limb_thickness: 1.0,
+                ..Default::default()
             },
             ..ok
         },
@@ -725,6 +731,7 @@ fn invalid_specs_are_rejected() {
             proportions: Proportions {
                 limb_length: 1.0,
                 limb_thickness: f64::INFINITY,
+                ..Default::default()
             },
             ..ok
         },

@@ -14,10 +14,13 @@ use shapecorr::transfer::TransferMode;
 use shapecorr::{NoProgress, Params, PointwiseCorrespondence, PointwiseParams, Shape};
 
 /// B's body: thicker and longer limbs than A's.
-const B_BODY: Proportions = Proportions {
-    limb_length: 1.1,
-    limb_thickness: 1.2,
-};
+fn b_body() -> Proportions {
+    Proportions {
+        limb_length: 1.1,
+        limb_thickness: 1.2,
+        ..Default::default()
+    }
+}
 /// The pose B is moved to for the re-posing test (A is in the rest pose, B in each other
 /// pose in turn).
 const REPOSE: usize = 5;
@@ -36,7 +39,7 @@ fn pair(n_a: usize, n_b: usize, pose_b: usize) -> Pair {
     let rig_a = synth::rig(FigureKind::Humanoid, n_a).unwrap();
     let rig_b = synth::rig(FigureKind::Humanoid, n_b).unwrap();
     let shape_a = Shape::mesh(rig_a.rest.vertices.clone(), &rig_a.rest.triangles).unwrap();
-    let posed_b = rig_b.deform(&rig_b.weights, B_BODY, pose_b).unwrap();
+    let posed_b = rig_b.deform(&rig_b.weights, b_body(), pose_b).unwrap();
     let shape_b = Shape::mesh(posed_b, &rig_b.rest.triangles).unwrap();
     let result = PointwiseCorrespondence::compute(
         &shape_a,
@@ -116,8 +119,8 @@ fn weight_error(got: &[f64], truth: &[f64]) -> f64 {
 /// Mean vertex error of B re-posed with `weights`, against B re-posed with its own weights,
 /// over B's height in that pose.
 fn repose_error(rig_b: &Rig, weights: &[f64]) -> f64 {
-    let truth = rig_b.deform(&rig_b.weights, B_BODY, REPOSE).unwrap();
-    let got = rig_b.deform(weights, B_BODY, REPOSE).unwrap();
+    let truth = rig_b.deform(&rig_b.weights, b_body(), REPOSE).unwrap();
+    let got = rig_b.deform(weights, b_body(), REPOSE).unwrap();
     let errors: Vec<f64> = got
         .iter()
         .zip(&truth)

@@ -33,12 +33,14 @@ fn repairs(b: &mut Bytes, how: u8) -> Repairs {
                     0.0
                 },
                 outliers: on & 4 != 0,
+                ..Default::default()
             }
         }
         _ => Repairs {
             weld_tolerance: b.f64(),
             debris_fraction: b.f64(),
             outliers: b.u8() & 1 != 0,
+            ..Default::default()
         },
     }
 }

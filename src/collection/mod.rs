@@ -43,6 +43,9 @@ pub struct Reading {
     pub points: bool,
     /// With the default repairs ([`Repairs::default`]); else as given.
     pub repair: bool,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for Reading {
@@ -50,6 +53,7 @@ impl Default for Reading {
         Reading {
             points: false,
             repair: true,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

@@ -67,6 +67,7 @@ pub unsafe extern "C" fn sc_batch_new(
             reading: Reading {
                 points: flags & SC_BATCH_POINTS != 0,
                 repair: flags & SC_BATCH_NO_REPAIR == 0,
+                ..Default::default()
             },
             outputs: if flags & SC_BATCH_MAPS != 0 {
                 Outputs::RegionsAndMaps

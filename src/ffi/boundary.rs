@@ -40,6 +40,11 @@ pub enum ScStatus {
     NumericalFailure = 17,
     /// The progress callback returned false.
     Cancelled = 18,
+    /// The job is too big for a limit: refused before any work by its estimate
+    /// (`memory_limit_mib`, `time_limit_s`, `max_vertices`, the memory available) or
+    /// stopped when it ran past `time_limit_s`. `sc_last_error` names the limit, the
+    /// estimate and what to do.
+    ResourceLimit = 19,
     /// An internal error (a bug in shapecorr): the call was stopped safely; please report
     /// the message of `sc_last_error`.
     Panic = 100,
@@ -62,11 +67,14 @@ impl ScStatus {
             ScStatus::FileError => c"file could not be read",
             ScStatus::NumericalFailure => c"numerical failure",
             ScStatus::Cancelled => c"cancelled by the progress callback",
+            ScStatus::ResourceLimit => {
+                c"the job exceeds a resource limit (memory, time or shape size)"
+            }
             ScStatus::Panic => c"internal error (a bug in shapecorr)",
         }
     }
 
-    const ALL: [ScStatus; 15] = [
+    const ALL: [ScStatus; 16] = [
         ScStatus::Ok,
         ScStatus::NullArgument,
         ScStatus::InvalidArgument,
@@ -81,6 +89,7 @@ impl ScStatus {
         ScStatus::FileError,
         ScStatus::NumericalFailure,
         ScStatus::Cancelled,
+        ScStatus::ResourceLimit,
         ScStatus::Panic,
     ];
 }
@@ -153,6 +162,7 @@ impl From<Error> for Failure {
             Error::Numerical { .. } => ScStatus::NumericalFailure,
             Error::Cancelled => ScStatus::Cancelled,
             Error::UnknownOption { .. } => ScStatus::UnknownOption,
+            Error::ResourceLimit { .. } => ScStatus::ResourceLimit,
             Error::InShape { .. } => unreachable!("innermost is never InShape"),
         };
         Failure::new(status, error.to_string())
@@ -382,6 +392,10 @@ mod tests {
             Error::UnknownOption {
                 name: String::new(),
                 known: String::new(),
+            },
+            Error::ResourceLimit {
+                limit: "memory_limit_mib",
+                reason: String::new(),
             },
         ];
         let statuses: Vec<ScStatus> = errors

@@ -64,7 +64,10 @@ pub const SC_CONFIDENCE_DOUBTFUL_BELOW: f64 = 0.45;
 /// and parameters, whatever the number of threads.
 ///
 /// Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work),
-/// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+/// `SC_STATUS_RESOURCE_LIMIT` (the job's estimate exceeds `memory_limit_mib`,
+/// `time_limit_s` or `max_vertices`, checked before any work, or it ran past
+/// `time_limit_s`), `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback
+/// returned false).
 ///
 /// # Safety
 /// `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,

@@ -214,16 +214,23 @@ pub unsafe extern "C" fn sc_params_get_bool(
     })
 }
 
-fn option_strings() -> &'static [(CString, CString)] {
-    static STRINGS: OnceLock<Vec<(CString, CString)>> = OnceLock::new();
+/// The C strings of one option: its name, its description and its choices' names.
+struct OptionStrings {
+    name: CString,
+    doc: CString,
+    choices: Vec<CString>,
+}
+
+fn option_strings() -> &'static [OptionStrings] {
+    static STRINGS: OnceLock<Vec<OptionStrings>> = OnceLock::new();
+    let c_string = |text: &str| CString::new(text).expect("the option table has no NUL");
     STRINGS.get_or_init(|| {
         OPTIONS
             .iter()
-            .map(|o| {
-                (
-                    CString::new(o.name).expect("option names have no NUL"),
-                    CString::new(o.doc).expect("option docs have no NUL"),
-                )
+            .map(|o| OptionStrings {
+                name: c_string(o.name),
+                doc: c_string(o.doc),
+                choices: o.choices.iter().map(|c| c_string(c)).collect(),
             })
             .collect()
     })
@@ -241,7 +248,7 @@ pub extern "C" fn sc_option_count() -> usize {
 pub extern "C" fn sc_option_name(index: usize) -> *const c_char {
     option_strings()
         .get(index)
-        .map_or(std::ptr::null(), |(name, _)| name.as_ptr())
+        .map_or(std::ptr::null(), |o| o.name.as_ptr())
 }
 
 /// One-line description of option `index` (static), or NULL past the end.
@@ -249,7 +256,20 @@ pub extern "C" fn sc_option_name(index: usize) -> *const c_char {
 pub extern "C" fn sc_option_doc(index: usize) -> *const c_char {
     option_strings()
         .get(index)
-        .map_or(std::ptr::null(), |(_, doc)| doc.as_ptr())
+        .map_or(std::ptr::null(), |o| o.doc.as_ptr())
+}
+
+/// Name of value `value` of option `index` when the option chooses among named
+/// alternatives (`p2p_regions`: `"none"`, `"one-to-one"`, `"symmetric"`; `p2p_refinement`:
+/// `"none"`, `"zoomout"`, `"icp"`), the name the command line also takes; static, never
+/// free it. NULL when the option is not a choice, or past its last value or the last
+/// option: values are numbered from 0, so a loop up to the first NULL lists them.
+#[no_mangle]
+pub extern "C" fn sc_option_choice(index: usize, value: usize) -> *const c_char {
+    option_strings()
+        .get(index)
+        .and_then(|o| o.choices.get(value))
+        .map_or(std::ptr::null(), |name| name.as_ptr())
 }
 
 /// Type of option `index`: `SC_OPTION_INT`, `SC_OPTION_DOUBLE` or `SC_OPTION_BOOL`;

@@ -45,7 +45,8 @@ pub const SC_P2P_REFINEMENT_ICP: i64 = 2;
 ///
 /// Errors: `SC_STATUS_INVALID_PARAMETER` (checked before any work, e.g. `p2p_fmap_size`
 /// above `p2p_eigenpairs`, or no region constraint and no descriptor),
-/// `SC_STATUS_NUMERICAL_FAILURE`, `SC_STATUS_CANCELLED` (the callback returned false).
+/// `SC_STATUS_RESOURCE_LIMIT` (as `sc_match`), `SC_STATUS_NUMERICAL_FAILURE`,
+/// `SC_STATUS_CANCELLED` (the callback returned false).
 ///
 /// # Safety
 /// `a`, `b` must be live shapes, `params` NULL or live parameters not being modified,

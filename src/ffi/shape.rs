@@ -64,6 +64,7 @@ fn repairs_of(flags: u32) -> Result<Repairs, Failure> {
             0.0
         },
         outliers: on(SC_REPAIR_OUTLIERS),
+        ..default
     })
 }
 
@@ -303,6 +304,7 @@ pub unsafe extern "C" fn sc_shape_new_figure(
             pose: pose as usize,
             target_vertices: target_vertices as usize,
             proportions: Proportions::default(),
+            ..Default::default()
         })?;
         let shape = Shape::mesh(mesh.vertices, &mesh.triangles)?;
         give_handle(out_shape, ScShape { shape })

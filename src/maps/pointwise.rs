@@ -89,6 +89,9 @@ pub struct PointwiseParams {
     /// hypothesis is solved and refined by ZoomOut on the samples; the map of lowest
     /// [`hypotheses::MapEnergy::cost`] wins, and only it is converted at full resolution.
     pub hypotheses: bool,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for PointwiseParams {
@@ -108,6 +111,7 @@ impl Default for PointwiseParams {
             refinement: Refinement::ZoomOut(ZoomOutParams::default()),
             orientation: true,
             hypotheses: true,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

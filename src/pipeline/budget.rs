@@ -163,8 +163,8 @@ impl Budget {
         }
     }
 
-    /// Refuses a job whose estimate exceeds the memory ceiling or the time limit, naming
-    /// the option and what to do.
+    /// Refuses a job whose estimate exceeds the memory ceiling or the time limit with
+    /// [`Error::ResourceLimit`], naming the option and what to do.
     pub fn check(&self, job: &Job) -> Result<Estimate> {
         let estimate = estimate(job);
         let [n_a, n_b] = job.vertices;
@@ -175,8 +175,8 @@ impl Budget {
         };
         if let Some(limit) = self.memory_limit_bytes() {
             if estimate.bytes > limit {
-                return Err(Error::InvalidParameter {
-                    name: "memory_limit_mib",
+                return Err(Error::ResourceLimit {
+                    limit: "memory_limit_mib",
                     reason: format!(
                         "the job on {pair} needs about {:.0} MiB, more than the {} {:.0} MiB; \
                          simplify the shapes, ask for fewer eigenpairs or raise \
@@ -193,8 +193,8 @@ impl Budget {
             }
         }
         if self.time_limit_s > 0.0 && estimate.seconds > self.time_limit_s {
-            return Err(Error::InvalidParameter {
-                name: "time_limit_s",
+            return Err(Error::ResourceLimit {
+                limit: "time_limit_s",
                 reason: format!(
                     "the job on {pair} would take about {:.0} s on a 2-core machine, more \
                      than time_limit_s = {} s; simplify the shapes or raise time_limit_s \
@@ -207,7 +207,8 @@ impl Budget {
     }
 
     /// Runs `work` with `progress` wrapped so that it also stops the work once the time
-    /// limit has passed; the work's cancel then becomes the error naming `time_limit_s`.
+    /// limit has passed; the work's cancel then becomes [`Error::ResourceLimit`] naming
+    /// `time_limit_s`.
     pub fn run<T>(
         &self,
         progress: &mut dyn Progress,
@@ -223,8 +224,8 @@ impl Budget {
         };
         let result = work(&mut watched);
         match (result, watched.passed_in) {
-            (Err(Error::Cancelled), Some(stage)) => Err(Error::InvalidParameter {
-                name: "time_limit_s",
+            (Err(Error::Cancelled), Some(stage)) => Err(Error::ResourceLimit {
+                limit: "time_limit_s",
                 reason: format!(
                     "the job ran past time_limit_s = {} s (in stage {stage:?}) and was \
                      stopped; raise time_limit_s (0: no limit) or simplify the shapes",

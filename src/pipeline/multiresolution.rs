@@ -30,6 +30,9 @@ pub struct Multiresolution {
     pub above: usize,
     /// About how many vertices a proxy has.
     pub proxy_vertices: usize,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 /// Default [`Multiresolution::above`]: 1.5 times the proxy's size (below it a proxy would
@@ -46,6 +49,7 @@ impl Default for Multiresolution {
         Multiresolution {
             above: DEFAULT_PROXY_ABOVE,
             proxy_vertices: DEFAULT_PROXY_VERTICES,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

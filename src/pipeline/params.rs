@@ -118,6 +118,9 @@ pub struct HksFallback {
     /// The second try runs when more than this fraction of the area (mean of A and B) is in
     /// regions without a symmetric match, or when the chosen k's degree histograms differ.
     pub max_unmatched: f64,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for HksFallback {
@@ -125,6 +128,7 @@ impl Default for HksFallback {
         HksFallback {
             hks_t_min: 0.015,
             max_unmatched: 0.02,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

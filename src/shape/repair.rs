@@ -27,6 +27,9 @@ pub struct Repairs {
     /// Drop far vertices (beyond [`FAR_FACTOR`] times the shape's robust radius) and, in a
     /// point cloud, isolated points (local-density test, [`OUTLIER_SPACING_FACTOR`]).
     pub outliers: bool,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for Repairs {
@@ -35,6 +38,7 @@ impl Default for Repairs {
             weld_tolerance: 1e-6,
             debris_fraction: 0.01,
             outliers: true,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -46,6 +50,7 @@ impl Repairs {
             weld_tolerance: 0.0,
             debris_fraction: 0.0,
             outliers: false,
+            ..Default::default()
         }
     }
 }

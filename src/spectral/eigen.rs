@@ -251,14 +251,14 @@ pub fn eigensolver_bytes(n: usize, params: &EigenParams) -> u64 {
 }
 
 /// Refuses a shape above [`EigenParams::max_vertices`], or one whose eigenbasis needs more
-/// memory than the system has, before anything is allocated.
+/// memory than the system has, before anything is allocated ([`Error::ResourceLimit`]).
 fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
     let n = shape.active_vertices().len();
     let needed = eigensolver_bytes(n, params);
     if let Some(available) = crate::system::available_bytes().filter(|&a| needed > a) {
         let gb = |b: u64| b as f64 / 1e9;
-        return Err(Error::InvalidParameter {
-            name: "eigenpairs",
+        return Err(Error::ResourceLimit {
+            limit: "available_memory",
             reason: format!(
                 "{} eigenpairs of a {n}-vertex shape need about {:.1} GB, more than the \
                  {:.1} GB available; ask for fewer eigenpairs or simplify the shape",
@@ -271,13 +271,13 @@ fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
     check_max_vertices(shape, params)
 }
 
-/// Refuses a shape above [`EigenParams::max_vertices`] (also checked on a dense input before
-/// its proxy is built, [`crate::multiresolution`]).
+/// Refuses a shape above [`EigenParams::max_vertices`] with [`Error::ResourceLimit`] (also
+/// checked on a dense input before its proxy is built, [`crate::multiresolution`]).
 pub(crate) fn check_max_vertices(shape: &Shape, params: &EigenParams) -> Result<()> {
     let n = shape.active_vertices().len();
     if n > params.max_vertices {
-        return Err(Error::InvalidParameter {
-            name: "max_vertices",
+        return Err(Error::ResourceLimit {
+            limit: "max_vertices",
             reason: format!(
                 "the shape has {n} vertices, more than max_vertices = {}; simplify it or \
                  raise max_vertices",

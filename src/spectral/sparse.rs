@@ -13,6 +13,18 @@ use sprs::CsMat;
 
 use crate::{Error, Result};
 
+/// The scratch memory of `stage` could not be allocated: the shape is too large for the
+/// memory the system can give.
+fn out_of_memory(stage: &str) -> Error {
+    Error::ResourceLimit {
+        limit: "available_memory",
+        reason: format!(
+            "the scratch memory of the {stage} could not be allocated; simplify the shape or \
+             free memory"
+        ),
+    }
+}
+
 /// `A = a L + diag(d)` for a symmetric stiffness `L` (both triangles stored), factored once.
 pub(crate) struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
@@ -58,7 +70,7 @@ impl SparseCholesky {
         let mut buffer = MemBuffer::try_new(
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
         )
-        .map_err(|_| numerical("out of memory".into()))?;
+        .map_err(|_| out_of_memory(stage))?;
         symbolic
             .factorize_numeric_llt(
                 &mut factor_values,
@@ -85,12 +97,8 @@ impl SparseCholesky {
 
     /// Scratch memory for solving `ncols` right-hand sides.
     pub fn scratch(&self, ncols: usize) -> Result<MemBuffer> {
-        MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par)).map_err(
-            |_| Error::Numerical {
-                stage: "sparse solve",
-                reason: "out of memory".into(),
-            },
-        )
+        MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par))
+            .map_err(|_| out_of_memory("sparse solve"))
     }
 
     /// Overwrites `rhs` with `A^{-1} rhs`.

@@ -112,6 +112,9 @@ pub struct Proportions {
     pub limb_length: f64,
     /// Scale factor of every limb bone across its axis (1.0 = default; finite, > 0).
     pub limb_thickness: f64,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for Proportions {
@@ -119,6 +122,7 @@ impl Default for Proportions {
         Proportions {
             limb_length: 1.0,
             limb_thickness: 1.0,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -135,6 +139,9 @@ pub struct FigureSpec {
     pub target_vertices: usize,
     /// Body proportions, applied as a deformation of the rest mesh.
     pub proportions: Proportions,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for FigureSpec {
@@ -144,6 +151,7 @@ impl Default for FigureSpec {
             pose: 0,
             target_vertices: 5000,
             proportions: Proportions::default(),
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }

@@ -41,6 +41,7 @@ fn dump() {
         let prop = Proportions {
             limb_length: var("SYNTH_LENGTH"),
             limb_thickness: var("SYNTH_THICKNESS"),
+            ..Default::default()
         };
         let meshes = figure_poses(kind, target, prop, &poses).unwrap();
         eprintln!(

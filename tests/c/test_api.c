@@ -79,6 +79,9 @@ static void test_version(void) {
 static void test_status_text(void) {
     CHECK(strcmp(sc_status_str(SC_STATUS_OK), "success") == 0, "%s", sc_status_str(0));
     CHECK(strstr(sc_status_str(SC_STATUS_CANCELLED), "cancel") != NULL, "cancelled text");
+    CHECK(strstr(sc_status_str(SC_STATUS_RESOURCE_LIMIT), "resource limit") != NULL, "%s",
+          sc_status_str(SC_STATUS_RESOURCE_LIMIT));
+    CHECK(SC_STATUS_RESOURCE_LIMIT == 19, "a new status takes the next number");
     CHECK(strcmp(sc_status_str(77777), "unknown status") == 0, "unknown status text");
     CHECK(sc_last_error() != NULL, "last error is never NULL");
 }
@@ -579,6 +582,41 @@ static void test_match_errors(void) {
     sc_shape_free(a);
 }
 
+/* A job too big for its limits is SC_STATUS_RESOURCE_LIMIT, not INVALID_PARAMETER: refused at
+   once by the memory ceiling (every kind of job) and by max_vertices, with a message naming
+   the limit and what to do; the same options out of their range stay INVALID_PARAMETER. */
+static void test_resource_limits(void) {
+    sc_shape *a = figure("star5", 0);
+    sc_params *params = NULL;
+    sc_correspondence *c_sentinel = (sc_correspondence *)(void *)&checks, *c = c_sentinel;
+    sc_symmetry *s_sentinel = (sc_symmetry *)(void *)&checks, *s = s_sentinel;
+    sc_pointwise *p_sentinel = (sc_pointwise *)(void *)&checks, *p = p_sentinel;
+    double t0;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "memory_limit_mib", -1), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_int(params, "memory_limit_mib", 1), SC_STATUS_OK);
+    t0 = now_seconds();
+    CHECK_STATUS(sc_match(a, a, params, NULL, NULL, &c), SC_STATUS_RESOURCE_LIMIT);
+    CHECK(strstr(sc_last_error(), "memory_limit_mib") != NULL, "message: %s", sc_last_error());
+    CHECK(strstr(sc_last_error(), "needs about") != NULL, "message: %s", sc_last_error());
+    CHECK(strstr(sc_last_error(), "raise memory_limit_mib") != NULL, "message: %s",
+          sc_last_error());
+    CHECK_STATUS(sc_symmetry_detect(a, params, NULL, NULL, &s), SC_STATUS_RESOURCE_LIMIT);
+    CHECK_STATUS(sc_pointwise_map(a, a, params, NULL, NULL, &p), SC_STATUS_RESOURCE_LIMIT);
+    CHECK(now_seconds() - t0 < 0.5, "refused before any work");
+    CHECK(c == c_sentinel && s == s_sentinel && p == p_sentinel, "no output on failure");
+    sc_params_free(params);
+
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_int(params, "max_vertices", 1), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_int(params, "max_vertices", 100), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, a, params, NULL, NULL, &c), SC_STATUS_RESOURCE_LIMIT);
+    CHECK(strstr(sc_last_error(), "max_vertices") != NULL, "message: %s", sc_last_error());
+    CHECK(c == c_sentinel, "no output on failure");
+    sc_params_free(params);
+    sc_shape_free(a);
+}
+
 static void test_cancellation(void) {
     sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 1);
     sc_correspondence *sentinel = (sc_correspondence *)(void *)&checks, *c = sentinel;
@@ -688,6 +726,24 @@ static void test_pointwise_options(void) {
     CHECK(flag, "region distances on by default");
     CHECK_STATUS(sc_params_get_bool(params, "p2p_wks", &flag), SC_STATUS_OK);
     CHECK(!flag, "WKS off by default");
+
+    /* The choices' names, by value, as the command line takes them. */
+    for (i = 0; i < sc_option_count(); i++) {
+        const char *name = sc_option_name(i);
+        if (strcmp(name, "p2p_refinement") == 0) {
+            CHECK(strcmp(sc_option_choice(i, SC_P2P_REFINEMENT_NONE), "none") == 0, "none");
+            CHECK(strcmp(sc_option_choice(i, SC_P2P_REFINEMENT_ZOOMOUT), "zoomout") == 0,
+                  "zoomout");
+            CHECK(strcmp(sc_option_choice(i, SC_P2P_REFINEMENT_ICP), "icp") == 0, "icp");
+            CHECK(sc_option_choice(i, 3) == NULL, "past the last choice");
+        } else if (strcmp(name, "p2p_regions") == 0) {
+            CHECK(strcmp(sc_option_choice(i, SC_P2P_REGIONS_SYMMETRIC), "symmetric") == 0,
+                  "symmetric");
+        } else {
+            CHECK(sc_option_choice(i, 0) == NULL, "%s is not a choice", name);
+        }
+    }
+    CHECK(sc_option_choice(sc_option_count(), 0) == NULL, "past the last option");
 
     /* Bad values: choices out of their list, wrong types, non-finite; nothing changes. */
     CHECK_STATUS(sc_params_set_int(params, "p2p_regions", 3), SC_STATUS_INVALID_PARAMETER);
@@ -1283,6 +1339,7 @@ int main(void) {
     test_shape_errors();
     test_repairs();
     test_match_errors();
+    test_resource_limits();
     test_life_cycle();
     test_point_cloud();
     test_unverified_has_no_confidence();

@@ -91,7 +91,13 @@ def main() -> int:
     print(f"{regions.k} clusters, {len(matches)} regions matched one to one, confidence "
           f"{'none' if confidence is None else f'{confidence:.2f}'}")
 
-    pointwise = shapecorr.pointwise_map(a, b)
+    # Options as a typed dict (or keyword arguments): mypy checks every name and type.
+    options: shapecorr.PointwiseOptions = {"p2p_refinement": "zoomout", "p2p_fmap_size": 40}
+    try:
+        pointwise = shapecorr.pointwise_map(a, b, **options)
+    except shapecorr.ResourceLimitError as refused:  # too big for this machine's limits
+        print(f"refused by {refused.limit}: {refused.message}", file=sys.stderr)
+        return 1
     map_b_to_a: NDArray[np.uint32] = pointwise.map_b_to_a
     error = np.linalg.norm(a_mesh.vertices[map_b_to_a] - a_mesh.vertices[order], axis=1)
     diameter = float(np.ptp(a_mesh.vertices, axis=0).max())

@@ -18,7 +18,11 @@ A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
     onto.transfer(weights_a, mode="weights", max_influences=4)   # A's data on B
 
 Options are the library's named options (``shapecorr.options()``), with the same defaults as
-the command line. Errors raise :class:`ShapecorrError` with the C status and the message.
+the command line, as typed keyword arguments (:class:`RegionOptions`,
+:class:`PointwiseOptions`: a type checker catches a misspelt one); a choice is taken by name
+or by value (``p2p_refinement="icp"`` or ``2``). Errors raise :class:`ShapecorrError` with
+the C status and the message; a job too big for its limits (memory, time, vertices) raises
+its subclass :class:`ResourceLimitError`.
 Shapes and results may be shared between threads; the library releases the GIL while it
 works (ctypes does). The package is typed (PEP 561): arrays are ``numpy.typing.NDArray``.
 """
@@ -29,10 +33,12 @@ import ctypes
 import functools
 import math
 import os
+import re
 import signal
+import sys
 import threading
 import weakref
-from typing import Any, Callable, Iterable, Literal, TypedDict, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Literal, NamedTuple, TypedDict, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -40,8 +46,14 @@ from numpy.typing import ArrayLike, NDArray
 from . import _lib
 from ._lib import lib
 
+if sys.version_info >= (3, 11):
+    from typing import Unpack
+elif TYPE_CHECKING:  # annotations only (PEP 563): nothing needs it at run time
+    from typing_extensions import Unpack
+
 __all__ = [
     "ShapecorrError",
+    "ResourceLimitError",
     "Shape",
     "Correspondence",
     "Symmetry",
@@ -56,8 +68,16 @@ __all__ = [
     "CONFIDENCE_DOUBTFUL_BELOW",
     "REPAIRS",
     "RegionGraph",
+    "OptionInfo",
     "OptionKind",
     "OptionValue",
+    "RegionOptions",
+    "PointwiseOptions",
+    "IntValue",
+    "FloatValue",
+    "BoolValue",
+    "RegionsChoice",
+    "RefinementChoice",
     "ProgressCallback",
     "RepairSpec",
     "Side",
@@ -81,6 +101,71 @@ StrPath = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]
 OptionKind = Literal["int", "float", "bool"]
 #: The modes of :meth:`SurfaceMap.transfer`.
 TransferMode = Literal["interpolate", "nearest", "weights"]
+#: The value of an ``"int"`` option.
+IntValue = Union[int, "np.integer[Any]"]
+#: The value of a ``"float"`` option.
+FloatValue = Union[float, "np.floating[Any]"]
+#: The value of a ``"bool"`` option.
+BoolValue = Union[bool, "np.bool_"]
+#: ``p2p_regions``: by name, or by value (0, 1, 2).
+RegionsChoice = Union[IntValue, Literal["none", "one-to-one", "symmetric"]]
+#: ``p2p_refinement``: by name, or by value (0, 1, 2).
+RefinementChoice = Union[IntValue, Literal["none", "zoomout", "icp"]]
+
+
+class RegionOptions(TypedDict, total=False):
+    """The options of :func:`match` and :func:`detect_symmetry`, as keyword arguments or a
+    dict to unpack (``**options``): the library's region options, each optional, with the
+    types of :func:`options`. A type checker refuses a misspelt name or a wrong type."""
+
+    k_min: IntValue
+    k_max: IntValue
+    kmeans_restarts: IntValue
+    max_regions: IntValue
+    min_region_area: FloatValue
+    seed: IntValue
+    hks_times: IntValue
+    hks_t_min: FloatValue
+    hks_t_max: FloatValue
+    hks_log: BoolValue
+    eigenpairs: IntValue
+    threads: IntValue
+    sigma: FloatValue
+    histogram_bins: IntValue
+    gap_ratio: FloatValue
+    max_symmetry_order: IntValue
+    one_to_one: BoolValue
+    exhaustive_limit: IntValue
+    symmetry_restarts: IntValue
+    hks_fallback: BoolValue
+    verify_hypotheses: BoolValue
+    proxy_above: IntValue
+    proxy_vertices: IntValue
+    max_vertices: IntValue
+    memory_limit_mib: IntValue
+    time_limit_s: FloatValue
+
+
+class PointwiseOptions(RegionOptions, total=False):
+    """The options of :func:`pointwise_map` (and of a batch): the region options and the
+    pointwise map's (``p2p_*``)."""
+
+    p2p_eigenpairs: IntValue
+    p2p_fmap_size: IntValue
+    p2p_regions: RegionsChoice
+    p2p_region_distances: BoolValue
+    p2p_wks: BoolValue
+    p2p_descriptor_step: IntValue
+    p2p_laplacian_weight: FloatValue
+    p2p_descriptor_commutativity: FloatValue
+    p2p_orientation_term: FloatValue
+    p2p_refinement: RefinementChoice
+    p2p_zoomout_end: IntValue
+    p2p_zoomout_step: IntValue
+    p2p_zoomout_sample: IntValue
+    p2p_icp_iterations: IntValue
+    p2p_orientation: BoolValue
+    p2p_hypotheses: BoolValue
 
 
 class ShapecorrError(Exception):
@@ -94,10 +179,28 @@ class ShapecorrError(Exception):
         super().__init__(f"{self.status_name}: {message}")
 
 
+class ResourceLimitError(ShapecorrError):
+    """A job too big for its limits (status ``RESOURCE_LIMIT``): refused before any work
+    because its estimated memory or time exceeds ``memory_limit_mib`` or ``time_limit_s``
+    (or a shape has more than ``max_vertices`` vertices, or needs more memory than the
+    system has), or stopped when it ran past ``time_limit_s``. ``limit`` names the limit:
+    the option, or ``"available_memory"``; the message gives the estimate and what to do.
+    A :class:`ShapecorrError`, so ``except ShapecorrError`` catches it too."""
+
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(status, message)
+        found = re.search(r"resource limit `([a-z_]+)`", message)
+        self.limit: str | None = found.group(1) if found else None
+
+
+#: The exception of a status, where it has its own (else :class:`ShapecorrError`).
+_ERRORS: dict[int, type[ShapecorrError]] = {_lib.STATUS_RESOURCE_LIMIT: ResourceLimitError}
+
+
 def _check(status):
     if status != 0:
         message = lib.sc_last_error().decode("utf-8", "replace")
-        raise ShapecorrError(status, message)
+        raise _ERRORS.get(status, ShapecorrError)(status, message)
 
 
 #: Below this confidence an answer is doubtful and has a warning (``SC_CONFIDENCE_DOUBTFUL_BELOW``).
@@ -386,19 +489,20 @@ class _Params(_Handle):
 
     def __init__(self, values):
         super().__init__(_new_handle(lib.sc_params_new))
-        types = {name: kind for name, kind, _, _ in options()}
-        for name, value in values.items():
-            kind = types.get(name)
-            if kind is None:
+        table = _option_table()
+        for name, value in _choice_values(values).items():
+            if name not in table:
                 # Let the library produce its message (it lists the options).
                 _check(lib.sc_params_set_int(self, name.encode(), 0))
+            kind, choices = table[name]
             setter = {
                 "int": lib.sc_params_set_int,
                 "float": lib.sc_params_set_double,
                 "bool": lib.sc_params_set_bool,
             }[kind]
-            if kind == "int" and (isinstance(value, bool) or int(value) != value):
-                raise ShapecorrError(2, f"option `{name}` takes an integer, got {value!r}")
+            if kind == "int" and (isinstance(value, (bool, str, bytes)) or int(value) != value):
+                names = f" or one of {', '.join(map(repr, choices))}" if choices else ""
+                raise ShapecorrError(2, f"option `{name}` takes an integer{names}, got {value!r}")
             if kind == "int" and name == "seed" and 2**63 <= int(value) < 2**64:
                 value = int(value) - 2**64  # a seed takes any 64-bit value
             if kind == "int" and not -(2**63) <= int(value) < 2**63:
@@ -414,13 +518,63 @@ _OPTION_KINDS: dict[int, OptionKind] = {
 }
 
 
-def options() -> list[tuple[str, OptionKind, str, int | float | bool]]:
-    """Every option as ``(name, type, description, default)``; type is ``"int"``,
-    ``"float"`` or ``"bool"``. The defaults are the library's (the same everywhere)."""
+@functools.lru_cache(maxsize=None)
+def _option_table() -> dict[str, tuple[OptionKind, tuple[str, ...]]]:
+    """Every option's kind and choices' names (by value), from the library's table."""
+    table = {}
+    for i in range(lib.sc_option_count()):
+        choices: list[str] = []
+        while (choice := lib.sc_option_choice(i, len(choices))) is not None:
+            choices.append(choice.decode())
+        table[lib.sc_option_name(i).decode()] = (_OPTION_KINDS[lib.sc_option_type(i)], tuple(choices))
+    return table
+
+
+def _choice_values(values):
+    """``values`` with every choice given by name (``p2p_refinement="icp"``, any case)
+    replaced by its value (2); an unknown name raises :class:`ShapecorrError`
+    (``INVALID_PARAMETER``, as a value out of the list does)."""
+    table = _option_table()
+    out = dict(values)
+    for name, value in values.items():
+        choices = table.get(name, ("int", ()))[1]
+        if choices and isinstance(value, str):
+            if value.strip().lower() not in choices:
+                listed = ", ".join(f"{choice} ({i})" for i, choice in enumerate(choices))
+                raise ShapecorrError(
+                    15, f"invalid parameter `{name}`: expected one of {listed}, got `{value}`"
+                )
+            out[name] = choices.index(value.strip().lower())
+    return out
+
+
+class OptionInfo(NamedTuple):
+    """One option of :func:`options`: it unpacks as ``name, kind, doc, default``."""
+
+    #: The name, as a keyword argument.
+    name: str
+    #: ``"int"``, ``"float"`` or ``"bool"``.
+    kind: OptionKind
+    #: One line: what it does.
+    doc: str
+    #: The library's default.
+    default: int | float | bool
+
+    @property
+    def choices(self) -> tuple[str, ...]:
+        """The names of a choice's values, by value (``p2p_refinement``: ``("none",
+        "zoomout", "icp")``), which it also takes; ``()`` for another option."""
+        return _option_table()[self.name][1]
+
+
+def options() -> list[OptionInfo]:
+    """Every option as ``(name, kind, doc, default)`` (:class:`OptionInfo`; ``kind`` is
+    ``"int"``, ``"float"`` or ``"bool"``; ``.choices`` lists the names a choice also takes).
+    The defaults are the library's (the same everywhere)."""
     defaults = ctypes.c_void_p()
     _check(lib.sc_params_new(ctypes.byref(defaults)))
     try:
-        result: list[tuple[str, OptionKind, str, int | float | bool]] = []
+        result: list[OptionInfo] = []
         for i in range(lib.sc_option_count()):
             name = lib.sc_option_name(i)
             kind = _OPTION_KINDS[lib.sc_option_type(i)]
@@ -431,7 +585,7 @@ def options() -> list[tuple[str, OptionKind, str, int | float | bool]]:
                 "bool": lib.sc_params_get_bool,
             }[kind]
             _check(getter(defaults, name, ctypes.byref(value)))
-            result.append((name.decode(), kind, lib.sc_option_doc(i).decode(), value.value))
+            result.append(OptionInfo(name.decode(), kind, lib.sc_option_doc(i).decode(), value.value))
         return result
     finally:
         lib.sc_params_free(defaults)
@@ -651,21 +805,22 @@ class Symmetry(_Handle):
 
 
 def match(
-    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: OptionValue
+    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: Unpack[RegionOptions]
 ) -> Correspondence:
     """Region correspondence between shapes ``a`` and ``b``. ``options`` are named options
-    (``k_min=5, k_max=10, one_to_one=True, ...``; see :func:`options`). ``progress``, if
-    given, is called as ``progress(stage, fraction)`` at least every 0.2 s and cancels by
-    returning a falsy value other than None (``False``, ``0``, ``np.False_``):
-    :class:`ShapecorrError` with status ``CANCELLED``. Ctrl-C cancels and raises
-    KeyboardInterrupt."""
+    (``k_min=5, k_max=10, one_to_one=True, ...``; :class:`RegionOptions`, see
+    :func:`options`). ``progress``, if given, is called as ``progress(stage, fraction)`` at
+    least every 0.2 s and cancels by returning a falsy value other than None (``False``,
+    ``0``, ``np.False_``): :class:`ShapecorrError` with status ``CANCELLED``. Ctrl-C cancels
+    and raises KeyboardInterrupt. A job over ``memory_limit_mib``, ``time_limit_s`` or
+    ``max_vertices`` raises :class:`ResourceLimitError`."""
     _expect(a, Shape, "a"), _expect(b, Shape, "b")
     params = _Params(options)
     return Correspondence(_Progress(progress).run(lib.sc_match, a, b, params))
 
 
 def detect_symmetry(
-    shape: Shape, progress: ProgressCallback | None = None, **options: OptionValue
+    shape: Shape, progress: ProgressCallback | None = None, **options: Unpack[RegionOptions]
 ) -> Symmetry:
     """Groups of mutually symmetric regions of one shape (arguments as :func:`match`)."""
     _expect(shape, Shape, "shape")
@@ -741,13 +896,14 @@ class PointwiseMap(_Handle):
 
 
 def pointwise_map(
-    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: OptionValue
+    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: Unpack[PointwiseOptions]
 ) -> PointwiseMap:
     """Point-to-point map from shape ``b`` to shape ``a``: the region correspondence of
     :func:`match`, then a functional map constrained by the matched regions, refined by
     ZoomOut. ``options`` are named options as for :func:`match`, plus the pointwise map's
-    (``p2p_fmap_size=40``, ``p2p_regions=1`` (0 none, 1 one-to-one, 2 symmetric),
-    ``p2p_refinement=1`` (0 none, 1 ZoomOut, 2 ICP), ``p2p_wks=False``, ...; see
+    (``p2p_fmap_size=40``, ``p2p_regions="one-to-one"`` (``"none"``, ``"one-to-one"``,
+    ``"symmetric"``, or 0, 1, 2), ``p2p_refinement="zoomout"`` (``"none"``, ``"zoomout"``,
+    ``"icp"``, or 0, 1, 2), ``p2p_wks=False``, ...; :class:`PointwiseOptions`, see
     :func:`options`). ``progress`` as for :func:`match`; the last stage is
     ``"pointwise_map"``. Returns a :class:`PointwiseMap`."""
     _expect(a, Shape, "a"), _expect(b, Shape, "b")

@@ -169,6 +169,7 @@ FUNCTIONS = {
     "sc_option_count": (c_size_t, []),
     "sc_option_name": (ctypes.c_char_p, [c_size_t]),
     "sc_option_doc": (ctypes.c_char_p, [c_size_t]),
+    "sc_option_choice": (ctypes.c_char_p, [c_size_t, c_size_t]),
     "sc_option_type": (ctypes.c_uint32, [c_size_t]),
     "sc_option_min": (ctypes.c_double, [c_size_t]),
     "sc_option_max": (ctypes.c_double, [c_size_t]),
@@ -286,8 +287,11 @@ STATUS_NAMES = {
     16: "FILE_ERROR",
     17: "NUMERICAL_FAILURE",
     18: "CANCELLED",
+    19: "RESOURCE_LIMIT",
     100: "PANIC",
 }
+#: ``SC_STATUS_RESOURCE_LIMIT``: the job is too big for a limit (memory, time, vertices).
+STATUS_RESOURCE_LIMIT = 19
 STAGE_NAMES = {
     1: "laplacian",
     2: "eigenbasis",

@@ -28,13 +28,18 @@ import sys
 import threading
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import OptionValue, _Params, _check, _lib
+from . import PointwiseOptions, _choice_values, _Params, _check, _lib
 from ._lib import lib
+
+if sys.version_info >= (3, 11):
+    from typing import Unpack
+elif TYPE_CHECKING:  # annotations only (PEP 563)
+    from typing_extensions import Unpack
 
 __all__ = ["match_pairs", "summary", "matrix", "write_matrix", "consistent_labels", "read_map"]
 
@@ -255,7 +260,7 @@ def match_pairs(
     workers: int | None = None,
     retry_failed: bool = False,
     progress: Callable[[int, int, Record], object] | None = None,
-    **options: OptionValue,
+    **options: Unpack[PointwiseOptions],
 ) -> Path:
     """Matches the ``pairs`` of ``shapes`` and writes a record per pair to
     ``out/pairs.jsonl`` (and ``out/shapes.jsonl``, ``out/maps/`` with ``maps=True``);
@@ -278,7 +283,7 @@ def match_pairs(
         "points": bool(points),
         "repair": bool(repair),
         "cache": str(Path(cache) if cache is not None else out / "cache"),
-        "options": options,
+        "options": _choice_values(options),  # choices by value, whichever way given
     }
     _check_same_settings(out, settings)
     _Batch.of(settings)  # bad options fail here, before any task is sent

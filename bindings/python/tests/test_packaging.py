@@ -62,6 +62,10 @@ def test_the_package_is_typed_and_mypy_reads_its_types(tmp_path):
         "import shapecorr\n"
         "name: str = shapecorr.Shape.figure().vertices\n"
         'shapecorr.match(shapecorr.Shape.figure(), "b.ply")\n'
+        "shape = shapecorr.Shape.figure()\n"
+        "shapecorr.match(shape, shape, k_mx=8)\n"
+        'shapecorr.pointwise_map(shape, shape, p2p_refinement="icpp")\n'
+        'shapecorr.pointwise_map(shape, shape, p2p_refinement="icp", p2p_regions=2, k_max=8)\n'
     )
     checked = subprocess.run(
         [sys.executable, "-m", "mypy", "--strict", "--no-incremental", str(wrong)],
@@ -70,4 +74,7 @@ def test_the_package_is_typed_and_mypy_reads_its_types(tmp_path):
     assert checked.returncode == 1, checked.stdout + checked.stderr
     assert 'expression has type "ndarray[' in checked.stdout and "float64" in checked.stdout
     assert 'Argument 2 to "match" has incompatible type "str"; expected "Shape"' in checked.stdout
-    assert "Found 2 errors" in checked.stdout, checked.stdout
+    # A misspelt option and a choice's name that does not exist (the options are typed).
+    assert 'Unexpected keyword argument "k_mx" for "match"' in checked.stdout
+    assert 'Argument "p2p_refinement" to "pointwise_map" has incompatible type' in checked.stdout
+    assert "Found 4 errors" in checked.stdout, checked.stdout

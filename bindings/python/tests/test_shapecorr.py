@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import shapecorr
-from shapecorr import ShapecorrError, _lib
+from shapecorr import ResourceLimitError, ShapecorrError, _lib
 
 REPOSITORY = Path(__file__).resolve().parents[3]
 SIZE = 2500
@@ -135,6 +135,91 @@ def test_options_and_defaults():
     assert table["gap_ratio"] == ("float", 0.9)
     assert table["one_to_one"] == ("bool", True)
     assert len(table) == _lib.lib.sc_option_count()
+    info = {option.name: option for option in shapecorr.options()}
+    assert info["k_min"].kind == "int" and info["k_min"].default == 5 and info["k_min"].doc
+    assert info["k_min"].choices == ()
+    assert info["p2p_refinement"].choices == ("none", "zoomout", "icp")
+    assert info["p2p_regions"].choices == ("none", "one-to-one", "symmetric")
+    assert [o.name for o in shapecorr.options() if o.choices] == ["p2p_regions", "p2p_refinement"]
+
+
+def read_back(options, name):
+    """The integer value of option ``name`` after setting ``options`` as the functions do."""
+    params, value = shapecorr._Params(options), ctypes.c_int64()
+    shapecorr._check(_lib.lib.sc_params_get_int(params, name.encode(), ctypes.byref(value)))
+    return value.value
+
+
+def test_choices_are_taken_by_name_or_by_value():
+    for option in shapecorr.options():
+        for value, name in enumerate(option.choices):
+            assert read_back({option.name: name}, option.name) == value, name
+            assert read_back({option.name: name.upper()}, option.name) == value, name
+            assert read_back({option.name: value}, option.name) == value, name
+            assert read_back({option.name: np.int32(value)}, option.name) == value, name
+    with pytest.raises(ShapecorrError) as error:
+        read_back({"p2p_refinement": "zoom"}, "p2p_refinement")
+    assert error.value.status_name == "INVALID_PARAMETER"
+    assert "none (0), zoomout (1), icp (2)" in error.value.message
+    with pytest.raises(ShapecorrError) as error:
+        read_back({"k_min": "five"}, "k_min")
+    assert error.value.status_name == "INVALID_ARGUMENT"
+    with pytest.raises(ShapecorrError) as error:
+        read_back({"p2p_refinement": 2.5}, "p2p_refinement")
+    assert error.value.status_name == "INVALID_ARGUMENT"
+    assert "'icp'" in error.value.message, error.value.message
+
+
+def test_the_typed_options_are_the_table():
+    """``RegionOptions`` and ``PointwiseOptions`` (the keyword arguments' types) name every
+    option of the library with its kind, the choices with their names."""
+    region = shapecorr.RegionOptions.__annotations__
+    pointwise = shapecorr.PointwiseOptions.__annotations__
+    table = shapecorr.options()
+    assert set(pointwise) == {o.name for o in table}
+    assert set(region) == {o.name for o in table if not o.name.startswith("p2p_")}
+    assert not shapecorr.PointwiseOptions.__required_keys__
+    expected = {"int": "IntValue", "float": "FloatValue", "bool": "BoolValue"}
+    for option in table:
+        annotation = pointwise[option.name]
+        text = getattr(annotation, "__forward_arg__", annotation)
+        if option.choices:
+            alias = getattr(shapecorr, text)
+            literal = [arg for arg in alias.__args__ if getattr(arg, "__origin__", None) is not None]
+            names = {name for arg in literal for name in arg.__args__}
+            assert names == set(option.choices), option.name
+        else:
+            assert text == expected[option.kind], option.name
+
+
+def test_a_job_over_its_limits_raises_resource_limit_error(humanoids):
+    """A job refused by the memory ceiling is a ResourceLimitError (status RESOURCE_LIMIT,
+    naming the limit), which ``except ShapecorrError`` still catches; the same option out of
+    its range is a plain INVALID_PARAMETER."""
+    a, b = shapecorr.Shape.figure("humanoid", 0, 700), shapecorr.Shape.figure("humanoid", 3, 700)
+    for call in [
+        lambda: shapecorr.match(a, b, memory_limit_mib=1),
+        lambda: shapecorr.detect_symmetry(a, memory_limit_mib=1),
+        lambda: shapecorr.pointwise_map(a, b, memory_limit_mib=1),
+    ]:
+        with pytest.raises(ResourceLimitError) as error:
+            call()
+        assert error.value.status == _lib.STATUS_RESOURCE_LIMIT == 19
+        assert error.value.status_name == "RESOURCE_LIMIT"
+        assert error.value.limit == "memory_limit_mib"
+        assert "needs about" in error.value.message
+        assert "raise memory_limit_mib" in error.value.message
+        try:
+            call()
+        except ShapecorrError as caught:  # what callers wrote before
+            assert isinstance(caught, ResourceLimitError)
+    with pytest.raises(ResourceLimitError) as error:
+        shapecorr.match(a, b, max_vertices=100)
+    assert error.value.limit == "max_vertices", error.value.message
+    with pytest.raises(ShapecorrError) as error:
+        shapecorr.match(a, b, memory_limit_mib=-1)
+    assert error.value.status_name == "INVALID_PARAMETER"
+    assert not isinstance(error.value, ResourceLimitError)
 
 
 def test_option_errors(humanoids):
@@ -404,7 +489,7 @@ def test_permuted_copy_is_mapped_back(humanoids):
 @pytest.mark.parametrize(
     "options, size",
     [
-        (dict(p2p_refinement=_lib.P2P_REFINEMENT_ICP), 40),
+        (dict(p2p_refinement="icp"), 40),
         (dict(p2p_refinement=_lib.P2P_REFINEMENT_NONE), 40),
         (dict(p2p_regions=_lib.P2P_REGIONS_SYMMETRIC), 100),
         (dict(p2p_regions=_lib.P2P_REGIONS_NONE, p2p_wks=True), 100),

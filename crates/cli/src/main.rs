@@ -1,5 +1,7 @@
 //! `shapecorr`: the command-line front end. Every command exits non-zero with a one-line
-//! reason on bad input.
+//! reason on bad input: status 2 for a usage error (clap's, an option out of its range),
+//! 1 for a failed job, whose reason is the library's error (`resource limit `NAME`: ...` for
+//! a job too big for its limits, docs/design.md, "Errors and status codes").
 //!
 //! One module per command under `commands/`; the method's options are generated from the
 //! library's option table (`options.rs`); the files every command writes are `output.rs`'s.

@@ -387,6 +387,7 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
             pose: 0,
             target_vertices: 3000,
             proportions: Default::default(),
+            ..Default::default()
         })
         .unwrap();
         let mirror = shapecorr::synth::mirror_map(&rest);

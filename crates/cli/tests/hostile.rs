@@ -325,3 +325,42 @@ fn a_time_limit_below_the_estimate_is_refused_at_once() {
     assert_clean_failure(&refused, &["time_limit_s", "would take about"]);
     assert!(started.elapsed() < Duration::from_secs(2), "not at once");
 }
+
+/// A job too big for its limits fails with the resource limit's one-line reason, told apart
+/// from a bad value: `--memory-limit-mib 1` refuses every job at once with
+/// `shapecorr: resource limit `memory_limit_mib`: ...` (exit status 1, as every failed
+/// job), `--max-vertices` below a shape's size names the limit and the file, while a value
+/// out of the option's range is a usage error (status 2) that names the option.
+#[test]
+fn a_job_over_its_limits_fails_with_a_resource_limit_line() {
+    let dir = scratch("resource-limit");
+    let (a, b) = (dir.join("a.ply"), dir.join("b.ply"));
+    synth(&a, "0");
+    synth(&b, "3");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    for (command, files) in [("match", &[a, b][..]), ("symmetry", &[a]), ("p2p", &[a, b])] {
+        let mut args = vec![command];
+        args.extend_from_slice(files);
+        args.extend_from_slice(&["--out", out, "--quiet", "--memory-limit-mib", "1"]);
+        let started = Instant::now();
+        let refused = shapecorr(&args);
+        assert!(started.elapsed() < Duration::from_secs(2), "not at once");
+        let err = stderr(&refused);
+        assert_eq!(refused.status.code(), Some(1), "{command}: {err}");
+        assert_eq!(err.lines().count(), 1, "{command}: one line: {err}");
+        assert!(
+            err.starts_with("shapecorr: resource limit `memory_limit_mib`: "),
+            "{command}: {err}"
+        );
+        assert_clean_failure(&refused, &["needs about", "raise memory_limit_mib"]);
+    }
+    let refused = shapecorr(&["match", a, b, "--out", out, "--max-vertices", "100"]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert_clean_failure(&refused, &["a.ply", "resource limit `max_vertices`"]);
+    let bad = shapecorr(&["match", a, b, "--out", out, "--memory-limit-mib=-1"]);
+    assert_eq!(bad.status.code(), Some(2), "{}", stderr(&bad));
+    assert_clean_failure(&bad, &["memory_limit_mib"]);
+    assert!(!stderr(&bad).contains("resource limit"), "{}", stderr(&bad));
+}

@@ -201,6 +201,7 @@ pub fn write_quick_dataset(root: &Path) -> Result<()> {
         Proportions {
             limb_length: 1.15,
             limb_thickness: 0.8,
+            ..Default::default()
         },
     ];
     let mut mirror = None;

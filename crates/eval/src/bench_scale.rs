@@ -143,6 +143,7 @@ fn pair_files(work: &Path, n: usize) -> Result<(PathBuf, PathBuf)> {
                 limb_thickness: 1.2,
                 ..Default::default()
             },
+            ..Default::default()
         })?;
         for _ in 0..splits {
             mesh = midpoint_split(&mesh);

@@ -119,6 +119,9 @@ pub struct GraphParams {
     pub min_region_area: f64,
     /// How expanded regions grow.
     pub expansion: RegionExpansion,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for GraphParams {
@@ -127,6 +130,7 @@ impl Default for GraphParams {
             metric: DEFAULT_METRIC,
             min_region_area: DEFAULT_MIN_REGION_AREA,
             expansion: RegionExpansion::SecondNearestBand,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -146,6 +150,9 @@ pub struct KMeansParams {
     /// Lloyd iterations per start at most (the iteration stops earlier when no label
     /// changes).
     pub max_iterations: usize,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for KMeansParams {
@@ -156,6 +163,7 @@ impl Default for KMeansParams {
             seed: 0x5eed,
             metric: DEFAULT_METRIC,
             max_iterations: DEFAULT_MAX_ITERATIONS,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -197,6 +205,9 @@ pub struct SegmentationParams {
     pub tie_break: KTieBreak,
     /// Seed of the k-means++ sampling (the same seed is used for every k).
     pub seed: u64,
+    /// Keeps the struct open to new fields: build it with `..Default::default()`.
+    #[doc(hidden)]
+    pub non_exhaustive: crate::NonExhaustive,
 }
 
 impl Default for SegmentationParams {
@@ -215,6 +226,7 @@ impl Default for SegmentationParams {
             expansion: RegionExpansion::SecondNearestBand,
             tie_break: KTieBreak::SmallestK,
             seed: 0x5eed,
+            non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
@@ -226,6 +238,7 @@ impl SegmentationParams {
             metric: self.metric,
             min_region_area: self.min_region_area,
             expansion: self.expansion,
+            ..Default::default()
         }
     }
 
@@ -422,6 +435,7 @@ pub fn segment_pair(
                     seed: params.seed,
                     metric: params.metric,
                     max_iterations: params.kmeans_max_iterations,
+                    ..Default::default()
                 };
                 let clustering = kmeans::kmeans(&points, &kmeans_params, cancel)?;
                 let centroids = clustering.centroids.as_ref();

@@ -94,6 +94,7 @@ impl BatchArgs {
             reading: Reading {
                 points: self.points,
                 repair: !self.no_repair,
+                ..Default::default()
             },
             outputs,
             cache_dir: self.cache.clone().unwrap_or_else(|| self.out.join("cache")),

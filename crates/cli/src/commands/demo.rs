@@ -35,6 +35,7 @@ impl DemoArgs {
             pose,
             target_vertices: vertices,
             proportions: Proportions::default(),
+            ..Default::default()
         };
         let t = Instant::now();
         let mesh_a = synth::figure(&spec(0))?;

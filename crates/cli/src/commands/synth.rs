@@ -52,7 +52,9 @@ impl SynthArgs {
             proportions: Proportions {
                 limb_length: self.limb_length,
                 limb_thickness: self.limb_thickness,
+                ..Default::default()
             },
+            ..Default::default()
         })?;
         let out = &self.out;
         match self.points {
