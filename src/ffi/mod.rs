@@ -1,5 +1,5 @@
 //! The stable C API: `include/shapecorr.h` is generated from this module by cbindgen
-//! (`cbindgen.toml`; `tests/header.rs` fails when the committed header drifts).
+//! (`cbindgen.toml`; `tests/it/header.rs` fails when the committed header drifts).
 //!
 //! No algorithm lives here: every function checks its arguments, calls the Rust API
 //! ([`crate::Shape`], [`crate::correspondence::Correspondence`], [`crate::options`]) and

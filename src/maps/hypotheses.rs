@@ -663,7 +663,7 @@ pub fn confidence(scores: &[HypothesisScore], chosen: usize) -> f64 {
 /// The cost at which the consistency factor of the confidence is 1/e. Good maps of hard
 /// development pairs cost up to 0.76 (TOSCA cat8 -> cat1), a six-limbed star matched to a
 /// quadruped about 0.45: a larger scale (0.75-1.0 flagged fewer good pairs, 6-8 of 120)
-/// let that mismatch through as confident (crates/cli/tests/cli.rs,
+/// let that mismatch through as confident (crates/cli/tests/it/cli.rs,
 /// `dissimilar_shapes_are_doubtful_and_warn`).
 pub const COST_SCALE: f64 = 0.5;
 /// The relative cost margin at which the margin factor of the confidence is 1 - 1/e.

@@ -70,7 +70,7 @@ pub struct MatchingParams {
     /// FAUST (126 pairs: symmetric accuracy 0.930 vs 0.927) and remeshed TOSCA (155 pairs:
     /// 0.860 vs 0.858), and on synthetic graphs that gain or lose a node (fraction of nodes
     /// matched 0.90 vs 0.75 after splitting an edge, equal precision); see
-    /// `tests/matching.rs`, `measure_variants*`.
+    /// `tests/it/matching.rs`, `measure_variants*`.
     pub normalise_histograms: bool,
     /// Discretisation gap: a sorted score below `gap_ratio` times the previous one ends a
     /// node's matches. Paper: 0.9 (authors' code: 0.95).
@@ -83,7 +83,7 @@ pub struct MatchingParams {
     /// with or slightly above the authors' ratio (symmetric / one-to-one-with-flip region
     /// accuracy, FAUST 126 pairs 0.930 / 0.923 vs 0.929 / 0.923; remeshed TOSCA 155 pairs
     /// 0.860 / 0.853 vs 0.857 / 0.851; per pair they differ on about 1 pair in 10, both
-    /// ways). `tests/matching.rs`, `measure_variants_on_benchmark_pairs`.
+    /// ways). `tests/it/matching.rs`, `measure_variants_on_benchmark_pairs`.
     pub distance_term: DistanceTerm,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]

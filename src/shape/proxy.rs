@@ -31,7 +31,7 @@ pub struct Proxy {
 }
 
 /// Proxy candidates checked per input vertex: the triangles around its nearest proxy
-/// vertices (not tuned; `tests/multiresolution.rs` checks that every located point lies
+/// vertices (not tuned; `tests/it/multiresolution.rs` checks that every located point lies
 /// within half a proxy edge of its vertex on a 12K figure with a 2K proxy).
 const NEAREST_PROXY_VERTICES: usize = 4;
 

@@ -1,5 +1,5 @@
 //! Unit tests of the figure pipeline's internals (the public behaviour is tested in
-//! `tests/synth_figures.rs`).
+//! `tests/it/synth_figures.rs`).
 
 use super::*;
 

@@ -1329,30 +1329,62 @@ static void test_batch(void) {
     CHECK(system(command) == 0, "%s", command);
 }
 
-int main(void) {
+/* Every test, in the order a plain run takes them. */
+static const struct {
+    const char *name;
+    void (*run)(void);
+} tests[] = {
+    {"version", test_version},
+    {"status_text", test_status_text},
+    {"options", test_options},
+    {"option_extremes", test_option_extremes},
+    {"shape_errors", test_shape_errors},
+    {"repairs", test_repairs},
+    {"match_errors", test_match_errors},
+    {"resource_limits", test_resource_limits},
+    {"life_cycle", test_life_cycle},
+    {"point_cloud", test_point_cloud},
+    {"unverified_has_no_confidence", test_unverified_has_no_confidence},
+    {"cancellation", test_cancellation},
+    {"cancel_huge_restarts", test_cancel_huge_restarts},
+    {"symmetry", test_symmetry},
+    {"pointwise_options", test_pointwise_options},
+    {"pointwise_errors", test_pointwise_errors},
+    {"pointwise_permuted_copy", test_pointwise_permuted_copy},
+    {"pointwise_cancellation", test_pointwise_cancellation},
+    {"transfer", test_transfer},
+    {"batch", test_batch},
+    {"concurrency", test_concurrency},
+};
+
+/* `test_api` runs every test; `test_api NAME...` runs the named ones (tests/c/run.sh runs a
+ * subset under valgrind); `test_api --list` prints the names. */
+int main(int argc, char **argv) {
+    const size_t n_tests = sizeof tests / sizeof tests[0];
     const char *q = getenv("SHAPECORR_TEST_QUICK");
+    size_t t;
+    int i;
     quick = q != NULL && strcmp(q, "1") == 0;
-    test_version();
-    test_status_text();
-    test_options();
-    test_option_extremes();
-    test_shape_errors();
-    test_repairs();
-    test_match_errors();
-    test_resource_limits();
-    test_life_cycle();
-    test_point_cloud();
-    test_unverified_has_no_confidence();
-    test_cancellation();
-    test_cancel_huge_restarts();
-    test_symmetry();
-    test_pointwise_options();
-    test_pointwise_errors();
-    test_pointwise_permuted_copy();
-    test_pointwise_cancellation();
-    test_transfer();
-    test_batch();
-    test_concurrency();
+    if (argc == 2 && strcmp(argv[1], "--list") == 0) {
+        for (t = 0; t < n_tests; t++)
+            printf("%s\n", tests[t].name);
+        return 0;
+    }
+    for (i = 1; i < argc; i++) {
+        for (t = 0; t < n_tests && strcmp(argv[i], tests[t].name) != 0; t++)
+            ;
+        if (t == n_tests) {
+            fprintf(stderr, "no test named %s (test_api --list names them)\n", argv[i]);
+            return 2;
+        }
+    }
+    for (t = 0; t < n_tests; t++) {
+        bool wanted = argc == 1;
+        for (i = 1; i < argc && !wanted; i++)
+            wanted = strcmp(argv[i], tests[t].name) == 0;
+        if (wanted)
+            tests[t].run();
+    }
     printf("%d checks, %d failures%s\n", checks, failures, quick ? " (quick)" : "");
     return failures == 0 ? 0 : 1;
 }

@@ -73,7 +73,7 @@ pub enum KMeansMetric {
 }
 
 /// Default k-means distance: Euclidean. Measured against the authors' city block on FAUST
-/// (`tests/segmentation.rs`, `faust_metric_comparison` and `faust_figures`): the share of
+/// (`tests/it/segmentation.rs`, `faust_metric_comparison` and `faust_figures`): the share of
 /// A's area whose corresponding point on B lies in a region of the same joint cluster was
 /// 0.975 vs 0.965 on 12 same-person pairs and 0.933 vs 0.913 on 12 different-person pairs
 /// with the chosen k, higher at k = 5 on all of 5 pairs measured per k, and 0.804 vs 0.779
@@ -172,7 +172,7 @@ impl Default for KMeansParams {
 pub const DEFAULT_MAX_ITERATIONS: usize = 100;
 
 /// Default smallest region, as a fraction of the shape's area; smaller connected regions
-/// are merged into a neighbour. Measured on FAUST (`tests/segmentation.rs`): the meshes have
+/// are merged into a neighbour. Measured on FAUST (`tests/it/segmentation.rs`): the meshes have
 /// no region below 0.009 at k = 5 (merging at 0.001-0.005 changes nothing; 0.01 starts
 /// merging real parts at k >= 6). Point clouds with 1% noise have specks of 1e-5 to 4e-4
 /// of the area that make graphs differ or fall apart; merging below 0.001-0.005 raised the
