@@ -278,7 +278,7 @@ fn readers(dir: &Path) {
                  0 0 0 1\r\n1 0 0 2\r\n1 1 0 3\r\n0 1 0 4\r\n4 0 1 2 3\r\n0 1\r\n";
     w("read_ply", "quad-crlf-edge.ply", quads.into());
     // Crashes found before, kept as seeds so that every run (with overflow checks, unlike
-    // the release tests) replays them: tests/fuzz_regressions.rs has each one too.
+    // the release tests) replays them: tests/it/fuzz_regressions.rs has each one too.
     let far = "ply\nformat ascii 1.0\nelement vertex 32\nproperty float x\nproperty float y\n\
                property float z\nend_header\n0 0 0\n1 0 0\n2 0 0\n3 0 0\n0 1 0\n1 1 0\n2 1 0\n\
                3 1 0\n0 2 0\n1 2 0\n2 2 0\n3 2 0\n0 3 0\n1 3 0\n2 3 0\n3 3 0\n0 0 1\n1 0 1\n\

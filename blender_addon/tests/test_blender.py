@@ -463,7 +463,7 @@ def test_transfer_carries_groups_colours_and_attributes_like_the_library(addon):
     # vertices.
     assert np.mean(part == labels) > 0.9
     assert pointwise.confidence is not None
-    # The UV map per corner, as the library carries it (tests/transfer.rs checks the seams).
+    # The UV map per corner, as the library carries it (tests/it/transfer.rs checks the seams).
     faces_a, loops_a = loop_triangles(a)
     faces_b, loops_b = loop_triangles(b)
     expected = onto.transfer_corners(library_shape(addon, a), faces_a, loop_uv(a, "cylinder")[loops_a], faces_b)

@@ -47,7 +47,7 @@ pub const DEFAULT_HKS_TIME: f64 = 0.1;
 
 /// Default number of level intervals, chosen to give the segment count of the paper's
 /// Reeb graphs (Table 1: 25.9 on FAUST, 20.7 on TOSCA, 6.2 on SCAPE). Measured on FAUST
-/// (tr_reg_000, 009, 010, 019, 020, 029, 030, 039, 040, 049; `tests/reeb.rs`,
+/// (tr_reg_000, 009, 010, 019, 020, 029, 030, 039, 040, 049; `tests/it/reeb.rs`,
 /// `faust_reeb_baseline`): 5 levels give 15-17 nodes per shape, 6 levels 19-20, 8 levels
 /// 26-28, 10 levels 32-35. TOSCA (cat0/1, dog0/1, horse0/5, centaur0/1): 8 levels give
 /// 28-34 nodes, 6 levels 20-27.
@@ -57,7 +57,7 @@ pub const DEFAULT_LEVELS: usize = 8;
 /// [`shapecorr::regions::segmentation::DEFAULT_MIN_REGION_AREA`]: about 14 vertices of a 6,890-vertex
 /// body). Clean meshes have no such specks (the ten FAUST shapes above: the same node
 /// counts with 0, 0.002 and 0.005 at 5-10 levels but one shape at 6 levels with 0.005);
-/// noisy point clouds have many (`tests/reeb.rs`, `merging_tames_a_noisy_point_cloud`).
+/// noisy point clouds have many (`tests/it/reeb.rs`, `merging_tames_a_noisy_point_cloud`).
 pub const DEFAULT_MIN_AREA_FRACTION: f64 = 0.002;
 
 /// Most level intervals accepted (a guard against a graph the matcher cannot handle).

@@ -26,6 +26,6 @@ fn committed_header_matches_the_code() {
     assert!(
         committed == generated,
         "include/shapecorr.h differs from what cbindgen generates from src/ffi; regenerate it \
-         with `SHAPECORR_BLESS_HEADER=1 cargo test --release --test header` and commit it"
+         with `SHAPECORR_BLESS_HEADER=1 cargo test --release --test it header::` and commit it"
     );
 }

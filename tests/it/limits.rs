@@ -299,7 +299,7 @@ fn a_job_started_from_the_only_global_pool_worker_finishes() {
     let mut child = std::process::Command::new(std::env::current_exe().unwrap())
         .args([
             "--exact",
-            "a_job_started_from_the_only_global_pool_worker_finishes",
+            "limits::a_job_started_from_the_only_global_pool_worker_finishes",
         ])
         .env(CHILD, "1")
         .env("RAYON_NUM_THREADS", "1")

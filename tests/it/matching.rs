@@ -1,6 +1,6 @@
 //! Graph matching on hand-made shape graphs: symmetric groups, permutation and swap
 //! identities, robustness to an extra node, determinism. Ignored tests measure the variants
-//! (`cargo test --release --test matching -- --ignored --nocapture`).
+//! (`cargo test --release --test it matching:: -- --ignored --nocapture`).
 
 use std::collections::BTreeSet;
 use std::time::Instant;

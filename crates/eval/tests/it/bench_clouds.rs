@@ -535,7 +535,7 @@ fn a_small_protocol_run_on_two_humanoid_poses() {
 
 /// FAUST tr_reg_000 -> tr_reg_009 (identity ground truth, mirror map
 /// `faust/template_mirror.txt`) at 3000 and 500 points, noise 0 and 2%, one trial:
-/// `cargo test --release --test bench_clouds -- --ignored --nocapture`.
+/// `cargo test --release -p shapecorr-eval --test it bench_clouds:: -- --ignored --nocapture`.
 #[test]
 #[ignore = "needs shared/data/faust; about 12 s in release"]
 fn faust_pair_quick_check() {

@@ -2,7 +2,7 @@
 //! shape graphs on generated figures, the choice of k on two poses, and (ignored, needs
 //! the FAUST data) the figures on real scans.
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 use std::path::Path;

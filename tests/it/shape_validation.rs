@@ -1,6 +1,6 @@
 //! Bad input gets its typed error; repairable input is repaired and reported, never a panic.
 
-mod common;
+use crate::common;
 
 use common::icosphere;
 use shapecorr::ReadAs;

@@ -761,8 +761,8 @@ fn kinds_parse_and_print() {
     assert_eq!(FigureSpec::default(), spec(FigureKind::Humanoid, 0, 5000));
 }
 
-/// Prints generation times (run in release: `cargo test --release --test synth_figures
-/// timing -- --ignored --nocapture`).
+/// Prints generation times (run in release: `cargo test --release --test it
+/// synth_figures::timing -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn timing() {

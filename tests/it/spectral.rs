@@ -1,7 +1,7 @@
 //! Identities of the Laplacian, the eigenbasis and the descriptors (STYLE.md: identities,
 //! not single values).
 
-mod common;
+use crate::common;
 
 use common::{icosphere, permutation, rel};
 use faer::Mat;

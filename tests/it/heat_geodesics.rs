@@ -1,7 +1,7 @@
 //! Heat-method geodesics against exact distances: a flat grid (Euclidean) and a sphere
 //! (great circles), one source and several, and the errors for bad sources.
 
-mod common;
+use crate::common;
 
 use shapecorr::geodesic::HeatGeodesics;
 use shapecorr::Shape;

@@ -1,6 +1,6 @@
 //! The point-cloud Laplacian follows the mesh's spectrum.
 
-mod common;
+use crate::common;
 
 use shapecorr::synth::{self, FigureKind, FigureSpec};
 use shapecorr::{EigenParams, Eigenbasis, Shape};

@@ -515,7 +515,7 @@ fn bad_input_is_an_error_not_a_panic() {
 /// FAUST pairs from the shared benchmark data (skips when absent): node counts per number
 /// of levels, and consecutive pairs of the list (`REEB_FAUST_SHAPES`, e.g. `000,009,019`)
 /// scored against the identity. Run with
-/// `cargo test --release --test reeb -- --ignored --nocapture faust`.
+/// `cargo test --release -p shapecorr-eval --test it reeb::faust -- --ignored --nocapture`.
 #[test]
 #[ignore = "reads ../shared/data/faust; a measurement, not a check"]
 fn faust_reeb_baseline() {

@@ -3,7 +3,7 @@
 //! is mapped back, two poses of one figure are mapped with a small geodesic error, and the
 //! result does not depend on the thread count.
 
-mod common;
+use crate::common;
 
 use faer::Mat;
 use shapecorr::correspondence::Params;

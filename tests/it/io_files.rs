@@ -785,7 +785,7 @@ fn write_rejects_bad_parameters_and_unwritable_paths() {
 }
 
 /// Timing of the benchmark files; run with
-/// `cargo test --release --test io_files -- --ignored --nocapture`.
+/// `cargo test --release --test it io_files:: -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn timing_benchmark_files() {
