@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The C API's tests: the header compiles alone as C99 and C++; tests/c/test_api.c (life
-# cycle, error paths, cancellation, threads, versions) runs plain, under AddressSanitizer +
-# UndefinedBehaviorSanitizer, and under valgrind (no definite leaks, no errors); the C++
-# wrapper test, the example program and the README's C example run on generated shapes.
+# cycle, error paths, cancellation, threads, versions) runs whole plain and under
+# AddressSanitizer + UndefinedBehaviorSanitizer (LeakSanitizer on), and its ownership tests
+# under valgrind (no definite leaks, no errors; see below); the C++ wrapper test, the example
+# program and the README's C example run on generated shapes.
 # Needs target/release/libshapecorr.so (tests/run_all.sh builds it first).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -39,15 +40,34 @@ echo "== test_api (AddressSanitizer + UndefinedBehaviorSanitizer)"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1 \
     "$out/test_api_asan"
 
-echo "== test_api (valgrind, quick sizes)"
+echo "== test_api (valgrind, quick sizes): the ownership tests"
 if ! command -v valgrind >/dev/null; then
     echo "installing valgrind"
     apt-get install -y -qq valgrind >/dev/null || { sudo apt-get update -qq && sudo apt-get install -y -qq valgrind >/dev/null; }
 fi
+# valgrind checks every access of the library's own (uninstrumented) code, which ASan does
+# not: it runs every test that hands memory across the API once, each handle's whole life
+# cycle and every getter into a caller's buffer (correspondence, symmetry, pointwise map,
+# surface map, batch), the error paths, a cancel in each kind of job, and calls from several
+# threads. It skips three tests that only run sc_match again, with no API call of their own
+# (point_cloud, unverified_has_no_confidence, and cancellation, which cancels at each stage):
+# they run whole plain and under ASan+UBSan+LSan above (a sixth of valgrind's time).
+ownership=(version status_text options option_extremes shape_errors repairs match_errors
+    life_cycle cancel_huge_restarts symmetry pointwise_options pointwise_errors
+    pointwise_permuted_copy pointwise_cancellation transfer batch)
 # --fair-sched: valgrind runs one thread at a time; fair turns keep the caller's thread,
-# which delivers a cancel, from waiting behind the workers.
-SHAPECORR_TEST_QUICK=1 valgrind -q --fair-sched=yes --leak-check=full --errors-for-leak-kinds=definite \
-    --show-leak-kinds=definite --error-exitcode=99 "$out/test_api"
+# which delivers a cancel, from waiting behind the workers. Since it runs one thread at a
+# time, the threads test (half the time) runs in a second valgrind beside the others: one
+# process a core.
+valgrind=(valgrind -q --fair-sched=yes --leak-check=full --errors-for-leak-kinds=definite
+    --show-leak-kinds=definite --error-exitcode=99)
+SHAPECORR_TEST_QUICK=1 "${valgrind[@]}" "$out/test_api" concurrency >"$out/valgrind_threads.log" 2>&1 &
+threads=$!
+status=0
+SHAPECORR_TEST_QUICK=1 "${valgrind[@]}" "$out/test_api" "${ownership[@]}" || status=$?
+wait $threads || status=$?
+cat "$out/valgrind_threads.log"
+[ $status -eq 0 ] || { echo "test_api under valgrind failed ($status)"; exit 1; }
 
 echo "== C++ wrapper"
 "$cxx" -std=c++17 "${warn[@]}" -O1 -Iinclude tests/c/test_cpp.cpp "${link[@]}" -o "$out/test_cpp"

@@ -4,9 +4,10 @@
  * result (in range, a warning exactly when doubtful, none unverified or for NULL), and the
  * point-to-point map (a permuted copy of a figure is mapped back to the identity).
  * Compiled as C99 with -Wall -Wextra -Wpedantic -Werror against include/shapecorr.h and
- * linked against the built libshapecorr.so by tests/c/run.sh (plain, under ASan+UBSan, and
- * under valgrind).
+ * linked against the built libshapecorr.so by tests/c/run.sh (every test plain and under
+ * ASan+UBSan, the ownership tests it names under valgrind).
  *
+ * `test_api NAME...` runs the named tests only; `test_api --list` names them all.
  * SHAPECORR_TEST_QUICK=1 (used under valgrind) makes the figures smaller and the thread
  * test shorter; the checks are the same.
  */
@@ -1273,29 +1274,61 @@ static void test_batch(void) {
     CHECK(system(command) == 0, "%s", command);
 }
 
-int main(void) {
+/* Every test, in the order a plain run takes them. */
+static const struct {
+    const char *name;
+    void (*run)(void);
+} tests[] = {
+    {"version", test_version},
+    {"status_text", test_status_text},
+    {"options", test_options},
+    {"option_extremes", test_option_extremes},
+    {"shape_errors", test_shape_errors},
+    {"repairs", test_repairs},
+    {"match_errors", test_match_errors},
+    {"life_cycle", test_life_cycle},
+    {"point_cloud", test_point_cloud},
+    {"unverified_has_no_confidence", test_unverified_has_no_confidence},
+    {"cancellation", test_cancellation},
+    {"cancel_huge_restarts", test_cancel_huge_restarts},
+    {"symmetry", test_symmetry},
+    {"pointwise_options", test_pointwise_options},
+    {"pointwise_errors", test_pointwise_errors},
+    {"pointwise_permuted_copy", test_pointwise_permuted_copy},
+    {"pointwise_cancellation", test_pointwise_cancellation},
+    {"transfer", test_transfer},
+    {"batch", test_batch},
+    {"concurrency", test_concurrency},
+};
+
+/* `test_api` runs every test; `test_api NAME...` runs the named ones (tests/c/run.sh runs a
+ * subset under valgrind); `test_api --list` prints the names. */
+int main(int argc, char **argv) {
+    const size_t n_tests = sizeof tests / sizeof tests[0];
     const char *q = getenv("SHAPECORR_TEST_QUICK");
+    size_t t;
+    int i;
     quick = q != NULL && strcmp(q, "1") == 0;
-    test_version();
-    test_status_text();
-    test_options();
-    test_option_extremes();
-    test_shape_errors();
-    test_repairs();
-    test_match_errors();
-    test_life_cycle();
-    test_point_cloud();
-    test_unverified_has_no_confidence();
-    test_cancellation();
-    test_cancel_huge_restarts();
-    test_symmetry();
-    test_pointwise_options();
-    test_pointwise_errors();
-    test_pointwise_permuted_copy();
-    test_pointwise_cancellation();
-    test_transfer();
-    test_batch();
-    test_concurrency();
+    if (argc == 2 && strcmp(argv[1], "--list") == 0) {
+        for (t = 0; t < n_tests; t++)
+            printf("%s\n", tests[t].name);
+        return 0;
+    }
+    for (i = 1; i < argc; i++) {
+        for (t = 0; t < n_tests && strcmp(argv[i], tests[t].name) != 0; t++)
+            ;
+        if (t == n_tests) {
+            fprintf(stderr, "no test named %s (test_api --list names them)\n", argv[i]);
+            return 2;
+        }
+    }
+    for (t = 0; t < n_tests; t++) {
+        bool wanted = argc == 1;
+        for (i = 1; i < argc && !wanted; i++)
+            wanted = strcmp(argv[i], tests[t].name) == 0;
+        if (wanted)
+            tests[t].run();
+    }
     printf("%d checks, %d failures%s\n", checks, failures, quick ? " (quick)" : "");
     return failures == 0 ? 0 : 1;
 }
