@@ -51,7 +51,7 @@ fi
 # surface map, batch), the error paths, a cancel in each kind of job, and calls from several
 # threads. It skips three tests that only run sc_match again, with no API call of their own
 # (point_cloud, unverified_has_no_confidence, and cancellation, which cancels at each stage):
-# they run whole plain and under ASan+UBSan+LSan above, 3 of the 13 minutes valgrind took.
+# they run whole plain and under ASan+UBSan+LSan above (a sixth of valgrind's time).
 ownership=(version status_text options option_extremes shape_errors repairs match_errors
     resource_limits life_cycle cancel_huge_restarts symmetry pointwise_options pointwise_errors
     pointwise_permuted_copy pointwise_cancellation transfer batch)

@@ -4,9 +4,10 @@
  * result (in range, a warning exactly when doubtful, none unverified or for NULL), and the
  * point-to-point map (a permuted copy of a figure is mapped back to the identity).
  * Compiled as C99 with -Wall -Wextra -Wpedantic -Werror against include/shapecorr.h and
- * linked against the built libshapecorr.so by tests/c/run.sh (plain, under ASan+UBSan, and
- * under valgrind).
+ * linked against the built libshapecorr.so by tests/c/run.sh (every test plain and under
+ * ASan+UBSan, the ownership tests it names under valgrind).
  *
+ * `test_api NAME...` runs the named tests only; `test_api --list` names them all.
  * SHAPECORR_TEST_QUICK=1 (used under valgrind) makes the figures smaller and the thread
  * test shorter; the checks are the same.
  */
