@@ -269,10 +269,11 @@ sc_status sc_batch_new(const sc_params *params,
                        uint32_t flags,
                        sc_batch **out_batch);
 
-// Frees a batch (NULL is a no-op).
+// Frees a batch (NULL is a no-op). It drops the caller's reference: a call still using the
+// handle (freed on another thread) keeps the object alive until that call returns.
 //
 // # Safety
-// `batch` NULL or live, and not used again.
+// `batch` NULL or live, and not passed to a call again.
 void sc_batch_free(sc_batch *batch);
 
 // The per-shape job: the shape in `path`, named `name` in the batch, read, its proxy built
@@ -318,10 +319,11 @@ const char *sc_batch_record_json(const sc_batch_record *record);
 // `record` NULL or live.
 bool sc_batch_record_ok(const sc_batch_record *record);
 
-// Frees a record (NULL is a no-op).
+// Frees a record (NULL is a no-op). It drops the caller's reference: a call still using the
+// handle (freed on another thread) keeps the object alive until that call returns.
 //
 // # Safety
-// `record` NULL or live, and not used again.
+// `record` NULL or live, and not passed to a call again.
 void sc_batch_record_free(sc_batch_record *record);
 
 // A short static description of a status code (`"unknown status"` for a number that is
@@ -357,10 +359,12 @@ sc_status sc_match(const sc_shape *a,
                    void *userdata,
                    sc_correspondence **out_correspondence);
 
-// Frees a correspondence; NULL is a no-op.
+// Frees a correspondence; NULL is a no-op. It drops the caller's reference: a call still using the
+// handle (freed from its progress callback, or on another thread) keeps the object alive
+// until that call returns.
 //
 // # Safety
-// `correspondence` must be NULL or live, not used afterwards.
+// `correspondence` must be NULL or live, not passed to a call afterwards.
 void sc_correspondence_free(sc_correspondence *correspondence);
 
 // The number of joint clusters chosen (0 for NULL).
@@ -499,10 +503,12 @@ const char *sc_correspondence_warning(const sc_correspondence *correspondence);
 // `out_params` must be writable.
 sc_status sc_params_new(sc_params **out_params);
 
-// Frees parameters; NULL is a no-op.
+// Frees parameters; NULL is a no-op. It drops the caller's reference: a call still using the
+// handle (freed from its progress callback, or on another thread) keeps the object alive
+// until that call returns.
 //
 // # Safety
-// `params` must be NULL or live parameters, not used afterwards.
+// `params` must be NULL or live parameters, not passed to a call afterwards.
 void sc_params_free(sc_params *params);
 
 // Sets an integer option by name (see `sc_option_name`). Errors:
@@ -598,10 +604,12 @@ sc_status sc_pointwise_map(const sc_shape *a,
                            void *userdata,
                            sc_pointwise **out_pointwise);
 
-// Frees a pointwise map; NULL is a no-op.
+// Frees a pointwise map; NULL is a no-op. It drops the caller's reference: a call still using the
+// handle (freed from its progress callback, or on another thread) keeps the object alive
+// until that call returns.
 //
 // # Safety
-// `pointwise` must be NULL or live, not used afterwards.
+// `pointwise` must be NULL or live, not passed to a call afterwards.
 void sc_pointwise_free(sc_pointwise *pointwise);
 
 // Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`, as given to
@@ -778,10 +786,12 @@ sc_status sc_shape_new_figure(const char *kind,
                               uint32_t target_vertices,
                               sc_shape **out_shape);
 
-// Frees a shape; NULL is a no-op.
+// Frees a shape; NULL is a no-op. It drops the caller's reference: a call still using the
+// handle (freed from its progress callback, or on another thread) keeps the object alive
+// until that call returns.
 //
 // # Safety
-// `shape` must be NULL or a live shape, not used afterwards.
+// `shape` must be NULL or a live shape, not passed to a call afterwards.
 void sc_shape_free(sc_shape *shape);
 
 // Number of vertices (points) of the shape, as given by the caller; 0 for NULL.
@@ -846,10 +856,12 @@ sc_status sc_symmetry_detect(const sc_shape *shape,
                              void *userdata,
                              sc_symmetry **out_symmetry);
 
-// Frees a symmetry result; NULL is a no-op.
+// Frees a symmetry result; NULL is a no-op. It drops the caller's reference: a call still using the
+// handle (freed from its progress callback, or on another thread) keeps the object alive
+// until that call returns.
 //
 // # Safety
-// `symmetry` must be NULL or live, not used afterwards.
+// `symmetry` must be NULL or live, not passed to a call afterwards.
 void sc_symmetry_free(sc_symmetry *symmetry);
 
 // Number of vertices of the shape (0 for NULL).
@@ -892,11 +904,12 @@ sc_status sc_symmetry_colors(const sc_symmetry *symmetry, uint8_t *out_rgba, siz
 
 // The surface map of a pointwise map: for every vertex of B, a point of A's surface (the
 // vertex map smoothed over B's neighbours and projected onto A's triangles). `a` and `b`
-// must be the shapes `pointwise` was computed from. `progress` may be NULL; its stage is
+// must be the shapes `pointwise` was computed from, in that order: each is checked by a
+// hash of its positions and faces kept with the map. `progress` may be NULL; its stage is
 // `SC_STAGE_TRANSFER`.
 //
-// Errors: `SC_STATUS_INVALID_ARGUMENT` when the shapes' vertex counts are not the map's,
-// `SC_STATUS_CANCELLED`.
+// Errors: `SC_STATUS_INVALID_ARGUMENT` when `a` or `b` is not the map's shape (another
+// vertex count, other positions or faces, or A and B swapped), `SC_STATUS_CANCELLED`.
 //
 // # Safety
 // `a`, `b`, `pointwise` must be live; `progress` NULL or a function safe to call with
@@ -908,10 +921,12 @@ sc_status sc_surface_map_new(const sc_shape *a,
                              void *userdata,
                              sc_surface_map **out_map);
 
-// Frees a surface map; NULL is a no-op.
+// Frees a surface map; NULL is a no-op. It drops the caller's reference: a call still using the
+// handle (freed from its progress callback, or on another thread) keeps the object alive
+// until that call returns.
 //
 // # Safety
-// `map` must be NULL or live, not used afterwards.
+// `map` must be NULL or live, not passed to a call afterwards.
 void sc_surface_map_free(sc_surface_map *map);
 
 // Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`); 0 for NULL or a bad side.
@@ -930,6 +945,14 @@ sc_status sc_surface_map_points(const sc_surface_map *map,
                                 uint32_t *out_vertices,
                                 double *out_weights,
                                 size_t len);
+
+// Copies, for every vertex of B, the vertex of A whose value `SC_TRANSFER_NEAREST` takes
+// (`sc_surface_map_n_vertices(map, SC_SIDE_B)` values) into `out_vertices` of `len`
+// elements: data of any type (64-bit ids, strings) is carried exactly by indexing it.
+//
+// # Safety
+// `map` must be live; `out_vertices` must point to `len` writable elements.
+sc_status sc_surface_map_nearest(const sc_surface_map *map, uint32_t *out_vertices, size_t len);
 
 // Carries `values_a` (A's vertices x `channels`, row-major, `n_values` elements) to B's
 // vertices by `mode` (`SC_TRANSFER_*`; `max_influences` is used by `SC_TRANSFER_WEIGHTS`
@@ -961,8 +984,10 @@ sc_status sc_surface_map_transfer(const sc_surface_map *map,
 // `faces_b_len` x `channels` elements.
 //
 // Errors: `SC_STATUS_INVALID_ARGUMENT` for a face length that is not a multiple of 3;
-// `SC_STATUS_INVALID_PARAMETER` for sizes that do not fit, vertex indices out of range or
-// values that are not finite; `SC_STATUS_BUFFER_TOO_SMALL`.
+// `SC_STATUS_INVALID_PARAMETER` for sizes that do not fit, vertex indices out of range,
+// values that are not finite, `a` not the map's shape A (checked by a hash of its
+// positions and faces), a point cloud `a`, or `faces_a` empty or not `a`'s triangles (all
+// of them; a face with a repeated corner is passed over); `SC_STATUS_BUFFER_TOO_SMALL`.
 //
 // # Safety
 // `map` and `a` must be live; each input must point to its length of readable elements and

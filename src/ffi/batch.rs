@@ -81,10 +81,11 @@ pub unsafe extern "C" fn sc_batch_new(
     })
 }
 
-/// Frees a batch (NULL is a no-op).
+/// Frees a batch (NULL is a no-op). It drops the caller's reference: a call still using the
+/// handle (freed on another thread) keeps the object alive until that call returns.
 ///
 /// # Safety
-/// `batch` NULL or live, and not used again.
+/// `batch` NULL or live, and not passed to a call again.
 #[no_mangle]
 pub unsafe extern "C" fn sc_batch_free(batch: *mut ScBatch) {
     free_handle(batch);
@@ -107,7 +108,8 @@ pub unsafe extern "C" fn sc_batch_prepare(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_record, "out_record")?;
-        let batch = &handle(batch, "batch")?.batch;
+        let batch = handle(batch, "batch")?;
+        let batch = &batch.batch;
         let name = input_str(name, "name")?;
         let path = input_path(path, "path")?;
         let (_, record) = batch.prepare(name, &path);
@@ -136,7 +138,8 @@ pub unsafe extern "C" fn sc_batch_match(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_record, "out_record")?;
-        let batch = &handle(batch, "batch")?.batch;
+        let batch = handle(batch, "batch")?;
+        let batch = &batch.batch;
         let name_a = input_str(name_a, "name_a")?;
         let name_b = input_str(name_b, "name_b")?;
         let path_a = input_path(path_a, "path_a")?;
@@ -181,10 +184,11 @@ pub unsafe extern "C" fn sc_batch_record_ok(record: *const ScBatchRecord) -> boo
     boundary_value(false, || Ok(handle(record, "record")?.ok))
 }
 
-/// Frees a record (NULL is a no-op).
+/// Frees a record (NULL is a no-op). It drops the caller's reference: a call still using the
+/// handle (freed on another thread) keeps the object alive until that call returns.
 ///
 /// # Safety
-/// `record` NULL or live, and not used again.
+/// `record` NULL or live, and not passed to a call again.
 #[no_mangle]
 pub unsafe extern "C" fn sc_batch_record_free(record: *mut ScBatchRecord) {
     free_handle(record);

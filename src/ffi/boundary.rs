@@ -4,6 +4,7 @@
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Arc;
 
 use crate::Error;
 
@@ -282,12 +283,24 @@ pub(crate) unsafe fn write_output<T: Copy>(
     Ok(())
 }
 
-/// The object behind a handle.
+/// A use of a handle for the length of one call: the object stays alive until the call
+/// returns, even when the caller frees the handle meanwhile (from the progress callback, or
+/// on another thread).
+pub(crate) type Held<T> = Arc<T>;
+
+/// The object behind a handle, held for the call ([`Held`]).
 ///
 /// # Safety
-/// When non-NULL, `ptr` must be a live handle of this type.
-pub(crate) unsafe fn handle<'a, T>(ptr: *const T, name: &str) -> FfiResult<&'a T> {
-    ptr.as_ref().ok_or_else(|| Failure::null(name))
+/// When non-NULL, `ptr` must be a live handle of this type (made by [`give_handle`] and not
+/// yet freed when the call started).
+pub(crate) unsafe fn handle<T>(ptr: *const T, name: &str) -> FfiResult<Held<T>> {
+    if ptr.is_null() {
+        return Err(Failure::null(name));
+    }
+    // SAFETY: a live handle is an `Arc` given out by `give_handle`, whose own reference
+    // keeps the count at 1 or more; this use adds one, dropped when the call ends.
+    Arc::increment_strong_count(ptr);
+    Ok(Arc::from_raw(ptr))
 }
 
 /// Checks an out-parameter for a handle before any work is done.
@@ -300,24 +313,28 @@ pub(crate) fn check_out<T>(out: *mut *mut T, name: &str) -> FfiResult {
 }
 
 /// Moves `value` to the heap and hands it to the caller through `out` (checked non-NULL
-/// with [`check_out`] first).
+/// with [`check_out`] first). The handle is the caller's reference to an `Arc`: calls that
+/// use it take their own ([`handle`]), so that `_free` during a call drops only the
+/// caller's, and the object goes when the last call using it returns.
 ///
 /// # Safety
 /// `out` must be a valid, writable pointer.
 pub(crate) unsafe fn give_handle<T>(out: *mut *mut T, value: T) -> FfiResult {
     check_out(out, "out")?;
-    *out = Box::into_raw(Box::new(value));
+    *out = Arc::into_raw(Arc::new(value)).cast_mut();
     Ok(())
 }
 
-/// Frees a handle made by [`give_handle`]; NULL is a no-op.
+/// Drops the caller's reference to a handle made by [`give_handle`]; NULL is a no-op. The
+/// object is freed now, or when the last call still using it returns.
 ///
 /// # Safety
-/// When non-NULL, `ptr` must be a live handle of this type, not used afterwards.
+/// When non-NULL, `ptr` must be a live handle of this type, not passed to any call
+/// afterwards.
 pub(crate) unsafe fn free_handle<T>(ptr: *mut T) {
     if !ptr.is_null() {
         // Dropping plain data cannot panic, but the boundary costs nothing.
-        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(ptr))));
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(Arc::from_raw(ptr.cast_const()))));
     }
 }
 

@@ -84,8 +84,10 @@ pub unsafe extern "C" fn sc_match(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_correspondence, "out_correspondence")?;
-        let a = &handle(a, "a")?.shape;
-        let b = &handle(b, "b")?.shape;
+        let a = handle(a, "a")?;
+        let a = &a.shape;
+        let b = handle(b, "b")?;
+        let b = &b.shape;
         let params = params_or_default(params);
         let mut progress = CallbackProgress {
             callback: progress,
@@ -96,10 +98,12 @@ pub unsafe extern "C" fn sc_match(
     })
 }
 
-/// Frees a correspondence; NULL is a no-op.
+/// Frees a correspondence; NULL is a no-op. It drops the caller's reference: a call still using the
+/// handle (freed from its progress callback, or on another thread) keeps the object alive
+/// until that call returns.
 ///
 /// # Safety
-/// `correspondence` must be NULL or live, not used afterwards.
+/// `correspondence` must be NULL or live, not passed to a call afterwards.
 #[no_mangle]
 pub unsafe extern "C" fn sc_correspondence_free(correspondence: *mut ScCorrespondence) {
     free_handle(correspondence)
@@ -129,7 +133,7 @@ unsafe fn count(
     c: *const ScCorrespondence,
     f: impl FnOnce(&ScCorrespondence) -> FfiResult<usize>,
 ) -> usize {
-    boundary_value(0, || f(handle(c, "correspondence")?))
+    boundary_value(0, || f(&*handle(c, "correspondence")?))
 }
 
 /// The number of joint clusters chosen (0 for NULL).
@@ -179,6 +183,7 @@ pub unsafe extern "C" fn sc_correspondence_regions(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         write_output(out_regions, len, &graph(c, side)?.labels, "out_regions")
     })
 }
@@ -209,6 +214,7 @@ pub unsafe extern "C" fn sc_correspondence_matches(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         let flat: Vec<u32> = matches(c, kind)?
             .iter()
             .flat_map(|&(i, j)| [i, j])
@@ -233,6 +239,7 @@ pub unsafe extern "C" fn sc_correspondence_colors(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         graph(c, side)?;
         matches(c, kind)?;
         let (a, b) = c.result.vertex_colors(kind == SC_MATCHES_ONE_TO_ONE);
@@ -276,6 +283,7 @@ pub unsafe extern "C" fn sc_correspondence_region_areas(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         write_output(out_areas, len, &graph(c, side)?.node_area, "out_areas")
     })
 }
@@ -294,6 +302,7 @@ pub unsafe extern "C" fn sc_correspondence_region_descriptors(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         let flat: Vec<f64> = graph(c, side)?
             .node_descriptor
             .iter()
@@ -330,6 +339,7 @@ pub unsafe extern "C" fn sc_correspondence_edges(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         let flat: Vec<u32> = graph(c, side)?
             .edges
             .iter()
@@ -353,6 +363,7 @@ pub unsafe extern "C" fn sc_correspondence_seconds(
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         let stage = input_str(stage, "stage")?;
         let out = out_seconds
             .as_mut()
@@ -392,6 +403,7 @@ pub unsafe extern "C" fn sc_correspondence_confidence(
 ) -> f64 {
     boundary_value(f64::NAN, || {
         let c = handle(correspondence, "correspondence")?;
+        let c = &*c;
         Ok(c.result.confidence().unwrap_or(f64::NAN))
     })
 }

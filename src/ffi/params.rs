@@ -43,10 +43,12 @@ pub unsafe extern "C" fn sc_params_new(out_params: *mut *mut ScParams) -> ScStat
     })
 }
 
-/// Frees parameters; NULL is a no-op.
+/// Frees parameters; NULL is a no-op. It drops the caller's reference: a call still using the
+/// handle (freed from its progress callback, or on another thread) keeps the object alive
+/// until that call returns.
 ///
 /// # Safety
-/// `params` must be NULL or live parameters, not used afterwards.
+/// `params` must be NULL or live parameters, not passed to a call afterwards.
 #[no_mangle]
 pub unsafe extern "C" fn sc_params_free(params: *mut ScParams) {
     free_handle(params)

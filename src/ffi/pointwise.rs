@@ -62,8 +62,10 @@ pub unsafe extern "C" fn sc_pointwise_map(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_pointwise, "out_pointwise")?;
-        let a = &handle(a, "a")?.shape;
-        let b = &handle(b, "b")?.shape;
+        let a = handle(a, "a")?;
+        let a = &a.shape;
+        let b = handle(b, "b")?;
+        let b = &b.shape;
         let options = options_or_default(params);
         let mut progress = CallbackProgress {
             callback: progress,
@@ -81,17 +83,19 @@ pub unsafe extern "C" fn sc_pointwise_map(
     })
 }
 
-/// Frees a pointwise map; NULL is a no-op.
+/// Frees a pointwise map; NULL is a no-op. It drops the caller's reference: a call still using the
+/// handle (freed from its progress callback, or on another thread) keeps the object alive
+/// until that call returns.
 ///
 /// # Safety
-/// `pointwise` must be NULL or live, not used afterwards.
+/// `pointwise` must be NULL or live, not passed to a call afterwards.
 #[no_mangle]
 pub unsafe extern "C" fn sc_pointwise_free(pointwise: *mut ScPointwise) {
     free_handle(pointwise)
 }
 
 unsafe fn count(p: *const ScPointwise, f: impl FnOnce(&ScPointwise) -> FfiResult<usize>) -> usize {
-    boundary_value(0, || f(handle(p, "pointwise")?))
+    boundary_value(0, || f(&*handle(p, "pointwise")?))
 }
 
 /// Number of vertices of one side (`SC_SIDE_A` or `SC_SIDE_B`, as given to
@@ -165,7 +169,8 @@ pub unsafe extern "C" fn sc_pointwise_fmap(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let fmap = &handle(pointwise, "pointwise")?.result.map.fmap_ab;
+        let fmap = handle(pointwise, "pointwise")?;
+        let fmap = &fmap.result.map.fmap_ab;
         let flat: Vec<f64> = (0..fmap.nrows())
             .flat_map(|i| (0..fmap.ncols()).map(move |j| fmap[(i, j)]))
             .collect();
@@ -208,7 +213,8 @@ pub unsafe extern "C" fn sc_pointwise_seconds(
     out_seconds: *mut f64,
 ) -> ScStatus {
     boundary(|| {
-        let p = &handle(pointwise, "pointwise")?.result;
+        let p = handle(pointwise, "pointwise")?;
+        let p = &p.result;
         let stage = input_str(stage, "stage")?;
         let out = out_seconds
             .as_mut()

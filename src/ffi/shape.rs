@@ -311,10 +311,12 @@ pub unsafe extern "C" fn sc_shape_new_figure(
     })
 }
 
-/// Frees a shape; NULL is a no-op.
+/// Frees a shape; NULL is a no-op. It drops the caller's reference: a call still using the
+/// handle (freed from its progress callback, or on another thread) keeps the object alive
+/// until that call returns.
 ///
 /// # Safety
-/// `shape` must be NULL or a live shape, not used afterwards.
+/// `shape` must be NULL or a live shape, not passed to a call afterwards.
 #[no_mangle]
 pub unsafe extern "C" fn sc_shape_free(shape: *mut ScShape) {
     free_handle(shape)
@@ -361,7 +363,8 @@ pub unsafe extern "C" fn sc_shape_vertices(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let shape = &handle(shape, "shape")?.shape;
+        let shape = handle(shape, "shape")?;
+        let shape = &shape.shape;
         let flat: Vec<f64> = shape.vertices().iter().flatten().copied().collect();
         write_output(out_xyz, len, &flat, "out_xyz")
     })
@@ -379,7 +382,8 @@ pub unsafe extern "C" fn sc_shape_triangles(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let shape = &handle(shape, "shape")?.shape;
+        let shape = handle(shape, "shape")?;
+        let shape = &shape.shape;
         let flat: Vec<u32> = shape.triangles().iter().flatten().copied().collect();
         write_output(out_triangles, len, &flat, "out_triangles")
     })
@@ -400,7 +404,8 @@ pub unsafe extern "C" fn sc_shape_warnings(
     len: usize,
 ) -> usize {
     boundary_value(0, || {
-        let shape = &handle(shape, "shape")?.shape;
+        let shape = handle(shape, "shape")?;
+        let shape = &shape.shape;
         let text: String = shape.warnings().iter().map(|w| format!("{w}\n")).collect();
         write_c_string(&text, buf, len)?;
         Ok(text.len())
@@ -420,7 +425,8 @@ pub unsafe extern "C" fn sc_shape_repairs(
     len: usize,
 ) -> usize {
     boundary_value(0, || {
-        let shape = &handle(shape, "shape")?.shape;
+        let shape = handle(shape, "shape")?;
+        let shape = &shape.shape;
         let text: String = shape
             .warnings()
             .iter()

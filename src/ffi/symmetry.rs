@@ -34,7 +34,8 @@ pub unsafe extern "C" fn sc_symmetry_detect(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_symmetry, "out_symmetry")?;
-        let shape = &handle(shape, "shape")?.shape;
+        let shape = handle(shape, "shape")?;
+        let shape = &shape.shape;
         let params = params_or_default(params);
         let mut progress = CallbackProgress {
             callback: progress,
@@ -45,10 +46,12 @@ pub unsafe extern "C" fn sc_symmetry_detect(
     })
 }
 
-/// Frees a symmetry result; NULL is a no-op.
+/// Frees a symmetry result; NULL is a no-op. It drops the caller's reference: a call still using the
+/// handle (freed from its progress callback, or on another thread) keeps the object alive
+/// until that call returns.
 ///
 /// # Safety
-/// `symmetry` must be NULL or live, not used afterwards.
+/// `symmetry` must be NULL or live, not passed to a call afterwards.
 #[no_mangle]
 pub unsafe extern "C" fn sc_symmetry_free(symmetry: *mut ScSymmetry) {
     free_handle(symmetry)
@@ -98,7 +101,8 @@ pub unsafe extern "C" fn sc_symmetry_regions(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let s = &handle(symmetry, "symmetry")?.result;
+        let s = handle(symmetry, "symmetry")?;
+        let s = &s.result;
         write_output(out_regions, len, &s.graph.labels, "out_regions")
     })
 }
@@ -115,7 +119,8 @@ pub unsafe extern "C" fn sc_symmetry_region_groups(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let s = &handle(symmetry, "symmetry")?.result;
+        let s = handle(symmetry, "symmetry")?;
+        let s = &s.result;
         let mut group_of = vec![0u32; s.graph.n_nodes()];
         for (g, members) in s.groups.iter().enumerate() {
             for &r in members {
@@ -138,7 +143,8 @@ pub unsafe extern "C" fn sc_symmetry_colors(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let s = &handle(symmetry, "symmetry")?.result;
+        let s = handle(symmetry, "symmetry")?;
+        let s = &s.result;
         write_output(out_rgba, len, &rgba(&s.vertex_colors()), "out_rgba")
     })
 }

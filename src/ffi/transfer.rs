@@ -31,11 +31,12 @@ pub const SC_TRANSFER_WEIGHTS: u32 = 2;
 
 /// The surface map of a pointwise map: for every vertex of B, a point of A's surface (the
 /// vertex map smoothed over B's neighbours and projected onto A's triangles). `a` and `b`
-/// must be the shapes `pointwise` was computed from. `progress` may be NULL; its stage is
+/// must be the shapes `pointwise` was computed from, in that order: each is checked by a
+/// hash of its positions and faces kept with the map. `progress` may be NULL; its stage is
 /// `SC_STAGE_TRANSFER`.
 ///
-/// Errors: `SC_STATUS_INVALID_ARGUMENT` when the shapes' vertex counts are not the map's,
-/// `SC_STATUS_CANCELLED`.
+/// Errors: `SC_STATUS_INVALID_ARGUMENT` when `a` or `b` is not the map's shape (another
+/// vertex count, other positions or faces, or A and B swapped), `SC_STATUS_CANCELLED`.
 ///
 /// # Safety
 /// `a`, `b`, `pointwise` must be live; `progress` NULL or a function safe to call with
@@ -51,9 +52,12 @@ pub unsafe extern "C" fn sc_surface_map_new(
 ) -> ScStatus {
     boundary(|| {
         check_out(out_map, "out_map")?;
-        let a = &handle(a, "a")?.shape;
-        let b = &handle(b, "b")?.shape;
-        let result = &handle(pointwise, "pointwise")?.result;
+        let a = handle(a, "a")?;
+        let a = &a.shape;
+        let b = handle(b, "b")?;
+        let b = &b.shape;
+        let result = handle(pointwise, "pointwise")?;
+        let result = &result.result;
         let n_a = result.regions.graph_a.labels.len();
         if a.n_vertices() != n_a || b.n_vertices() != result.map.p2p_ba.len() {
             return Err(Failure::invalid(format!(
@@ -64,6 +68,9 @@ pub unsafe extern "C" fn sc_surface_map_new(
                 result.map.p2p_ba.len()
             )));
         }
+        result
+            .check_shapes(a, b)
+            .map_err(|e| Failure::invalid(e.to_string()))?;
         let mut progress = CallbackProgress {
             callback: progress,
             userdata,
@@ -73,10 +80,12 @@ pub unsafe extern "C" fn sc_surface_map_new(
     })
 }
 
-/// Frees a surface map; NULL is a no-op.
+/// Frees a surface map; NULL is a no-op. It drops the caller's reference: a call still using the
+/// handle (freed from its progress callback, or on another thread) keeps the object alive
+/// until that call returns.
 ///
 /// # Safety
-/// `map` must be NULL or live, not used afterwards.
+/// `map` must be NULL or live, not passed to a call afterwards.
 #[no_mangle]
 pub unsafe extern "C" fn sc_surface_map_free(map: *mut ScSurfaceMap) {
     free_handle(map)
@@ -89,7 +98,8 @@ pub unsafe extern "C" fn sc_surface_map_free(map: *mut ScSurfaceMap) {
 #[no_mangle]
 pub unsafe extern "C" fn sc_surface_map_n_vertices(map: *const ScSurfaceMap, side: u32) -> usize {
     boundary_value(0, || {
-        let map = &handle(map, "map")?.map;
+        let map = handle(map, "map")?;
+        let map = &map.map;
         match side {
             SC_SIDE_A => Ok(map.n_vertices_a),
             SC_SIDE_B => Ok(map.points.len()),
@@ -114,11 +124,31 @@ pub unsafe extern "C" fn sc_surface_map_points(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let map = &handle(map, "map")?.map;
+        let map = handle(map, "map")?;
+        let map = &map.map;
         let vertices: Vec<u32> = map.points.iter().flat_map(|p| p.vertices).collect();
         let weights: Vec<f64> = map.points.iter().flat_map(|p| p.weights).collect();
         write_output(out_vertices, len, &vertices, "out_vertices")?;
         write_output(out_weights, len, &weights, "out_weights")
+    })
+}
+
+/// Copies, for every vertex of B, the vertex of A whose value `SC_TRANSFER_NEAREST` takes
+/// (`sc_surface_map_n_vertices(map, SC_SIDE_B)` values) into `out_vertices` of `len`
+/// elements: data of any type (64-bit ids, strings) is carried exactly by indexing it.
+///
+/// # Safety
+/// `map` must be live; `out_vertices` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_surface_map_nearest(
+    map: *const ScSurfaceMap,
+    out_vertices: *mut u32,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let map = handle(map, "map")?;
+        let nearest: Vec<u32> = map.map.points.iter().map(|p| p.nearest()).collect();
+        write_output(out_vertices, len, &nearest, "out_vertices")
     })
 }
 
@@ -145,7 +175,8 @@ pub unsafe extern "C" fn sc_surface_map_transfer(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let map = &handle(map, "map")?.map;
+        let map = handle(map, "map")?;
+        let map = &map.map;
         let values = input_slice(values_a, n_values, "values_a")?;
         let mode = transfer_mode(mode, max_influences)?;
         let out = map.transfer(values, channels, mode)?;
@@ -163,8 +194,10 @@ pub unsafe extern "C" fn sc_surface_map_transfer(
 /// `faces_b_len` x `channels` elements.
 ///
 /// Errors: `SC_STATUS_INVALID_ARGUMENT` for a face length that is not a multiple of 3;
-/// `SC_STATUS_INVALID_PARAMETER` for sizes that do not fit, vertex indices out of range or
-/// values that are not finite; `SC_STATUS_BUFFER_TOO_SMALL`.
+/// `SC_STATUS_INVALID_PARAMETER` for sizes that do not fit, vertex indices out of range,
+/// values that are not finite, `a` not the map's shape A (checked by a hash of its
+/// positions and faces), a point cloud `a`, or `faces_a` empty or not `a`'s triangles (all
+/// of them; a face with a repeated corner is passed over); `SC_STATUS_BUFFER_TOO_SMALL`.
 ///
 /// # Safety
 /// `map` and `a` must be live; each input must point to its length of readable elements and
@@ -184,8 +217,10 @@ pub unsafe extern "C" fn sc_surface_map_transfer_corners(
     len: usize,
 ) -> ScStatus {
     boundary(|| {
-        let map = &handle(map, "map")?.map;
-        let a = &handle(a, "a")?.shape;
+        let map = handle(map, "map")?;
+        let map = &map.map;
+        let a = handle(a, "a")?;
+        let a = &a.shape;
         let faces_a = triangles(input_slice(faces_a, faces_a_len, "faces_a")?, "faces_a")?;
         let faces_b = triangles(input_slice(faces_b, faces_b_len, "faces_b")?, "faces_b")?;
         let values = input_slice(corner_values_a, n_values, "corner_values_a")?;

@@ -365,8 +365,16 @@ fn constraint_groups(
     let groups = region_groups(regions, kind);
     if groups.is_empty() {
         return Err(Error::InvalidParameter {
-            name: "regions",
-            reason: "the region correspondence has no match to constrain the map".into(),
+            name: "p2p_regions",
+            reason: format!(
+                "the region correspondence has no {} match to constrain the map; use another \
+                 p2p_regions (symmetric, or none with p2p_wks)",
+                if kind == RegionConstraints::OneToOne {
+                    "one-to-one"
+                } else {
+                    "symmetric"
+                }
+            ),
         });
     }
     Ok(groups)

@@ -42,6 +42,8 @@ pub struct SurfaceMap {
     pub points: Vec<SurfacePoint>,
     /// A's vertex count (every index of `points` is below it).
     pub n_vertices_a: usize,
+    /// A's [`Shape::fingerprint`]: per-corner transfers check that they are given A.
+    pub fingerprint_a: u64,
 }
 
 impl SurfaceMap {
@@ -79,6 +81,7 @@ impl SurfaceMap {
         Ok(SurfaceMap {
             points,
             n_vertices_a: a.n_vertices(),
+            fingerprint_a: a.fingerprint(),
         })
     }
 

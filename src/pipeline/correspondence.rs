@@ -20,14 +20,14 @@ use crate::pipeline::params::{HksFallback, Params};
 use crate::pipeline::pointwise::verify_regions;
 use crate::progress::{check, NoProgress, Progress, Stage};
 use crate::regions::graph::ShapeGraph;
-use crate::regions::matching::{match_graphs, GraphMatching};
+use crate::regions::matching::{match_graphs, overlong_lists, GraphMatching, MatchingParams};
 use crate::regions::segmentation::{segment_pair, Described, JointSegmentation, KCandidate};
 use crate::regions::symmetry::one_to_one;
 use crate::regions::RegionMatches;
 use crate::shape::Shape;
 use crate::spectral::descriptors::{hks, HksParams};
 use crate::spectral::eigen::{Eigenbasis, ShapeBasis};
-use crate::Result;
+use crate::{Error, Result};
 
 /// Seconds spent in each stage.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -133,6 +133,9 @@ impl Correspondence {
             None => (segmentation, matching),
         };
 
+        if matching.matches.is_empty() {
+            return Err(no_match(&segmentation, &matching, params));
+        }
         check(progress, Stage::SymmetryBreaking, 0.0)?;
         let t = Instant::now();
         let matches_one_to_one = one_to_one_matches(
@@ -205,6 +208,44 @@ impl Correspondence {
             self.graph_b.n_nodes(),
             pairs,
         )
+    }
+}
+
+/// The error of a matching that paired no region of A with one of B: an answer with no
+/// match is no correspondence (every colour grey, nothing to constrain a map), so it fails,
+/// naming `gap_ratio` and `max_symmetry_order` when the candidate lists were too long for
+/// them ([`overlong_lists`]).
+fn no_match(seg: &JointSegmentation, m: &GraphMatching, params: &Params) -> Error {
+    let (n_a, n_b) = (seg.graph_a.n_nodes(), seg.graph_b.n_nodes());
+    let p = &params.matching;
+    let overlong = overlong_lists(&m.scores, (n_a, n_b), p.gap_ratio, p.max_symmetry_order);
+    let found = format!(
+        "no region of A was matched to one of B (k = {}, {n_a} and {n_b} regions)",
+        seg.k
+    );
+    if overlong > 0 {
+        Error::InvalidParameter {
+            name: "gap_ratio",
+            reason: format!(
+                "{found}: {overlong} of the {} regions had more than max_symmetry_order = {} \
+                 candidates within a factor gap_ratio = {} of each other, so none was kept; \
+                 use a gap_ratio nearer 1 (default {}) or a larger max_symmetry_order \
+                 (default {})",
+                n_a + n_b,
+                p.max_symmetry_order,
+                p.gap_ratio,
+                MatchingParams::default().gap_ratio,
+                MatchingParams::default().max_symmetry_order,
+            ),
+        }
+    } else {
+        Error::Numerical {
+            stage: "graph matching",
+            reason: format!(
+                "{found}: the two shape graphs agree on no region; check that the shapes are \
+                 of one kind, or try other k_min and k_max"
+            ),
+        }
     }
 }
 

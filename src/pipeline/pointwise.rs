@@ -11,7 +11,7 @@ use crate::pipeline::Params;
 use crate::progress::{check, AsStage, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::eigen::{EigenParams, Eigenbasis, ShapeBasis};
-use crate::Result;
+use crate::{Error, Result};
 
 /// Everything from two shapes: eigenbases, region correspondence, pointwise map.
 #[derive(Debug, Clone)]
@@ -31,6 +31,8 @@ pub struct PointwiseCorrespondence {
     pub total: f64,
     /// What the job was estimated to take before it started ([`crate::pipeline::budget`]).
     pub estimate: Estimate,
+    /// [`Shape::fingerprint`] of A and B: [`PointwiseCorrespondence::check_shapes`].
+    pub fingerprints: [u64; 2],
 }
 
 impl PointwiseCorrespondence {
@@ -60,6 +62,37 @@ impl PointwiseCorrespondence {
             proxies: pair.proxies_s,
             total: pair.total_s,
             estimate: pair.estimate,
+            fingerprints: [a.fingerprint(), b.fingerprint()],
+        })
+    }
+
+    /// Checks that `a` and `b` are the shapes the map was computed from, in that order
+    /// (their [`Shape::fingerprint`]s): a shape with the same vertex count but other
+    /// positions or faces, or A and B swapped, is refused.
+    pub fn check_shapes(&self, a: &Shape, b: &Shape) -> Result<()> {
+        let [fa, fb] = self.fingerprints;
+        let given = [a.fingerprint(), b.fingerprint()];
+        if given == [fa, fb] {
+            return Ok(());
+        }
+        let (name, shape, side) = if given[0] != fa {
+            ("a", a, "A")
+        } else {
+            ("b", b, "B")
+        };
+        let hint = if given == [fb, fa] {
+            ": A and B are swapped"
+        } else {
+            ""
+        };
+        Err(Error::InvalidParameter {
+            name,
+            reason: format!(
+                "is not the shape {side} the pointwise map was computed from (it has {} \
+                 vertices, but other positions or faces{hint}); pass the two shapes given to \
+                 the pointwise map, in the same order",
+                shape.n_vertices()
+            ),
         })
     }
 

@@ -73,7 +73,7 @@ pub struct MatchingParams {
     /// `tests/it/matching.rs`, `measure_variants*`.
     pub normalise_histograms: bool,
     /// Discretisation gap: a sorted score below `gap_ratio` times the previous one ends a
-    /// node's matches. Paper: 0.9 (authors' code: 0.95).
+    /// node's matches (0: only a zero score does). Paper: 0.9 (authors' code: 0.95).
     pub gap_ratio: f64,
     /// At most this many matches per node (symmetric groups); a node whose gap comes later
     /// stays unmatched. Paper: 8 (authors' code: 10).
@@ -119,10 +119,10 @@ impl MatchingParams {
                 "must be at least 1, got 0".into(),
             ));
         }
-        if !(self.gap_ratio > 0.0 && self.gap_ratio <= 1.0) {
+        if !(0.0..=1.0).contains(&self.gap_ratio) {
             return Err(invalid(
                 "gap_ratio",
-                format!("must be in (0, 1], got {}", self.gap_ratio),
+                format!("must be in [0, 1], got {}", self.gap_ratio),
             ));
         }
         if self.max_symmetry_order == 0 {
@@ -738,6 +738,46 @@ fn small_eigen(h: &[f64], m: usize, stride: usize) -> Result<(Vec<f64>, Mat<f64>
     Ok((values, u))
 }
 
+/// Sorts one node's `(score, index)` candidates high to low (ties by index) and returns how
+/// many come before the cut of [`discretise`]; None when no score is positive.
+fn list_length(values: &mut [(f64, usize)], gap_ratio: f64) -> Option<usize> {
+    values.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+    if values.is_empty() || !(values[0].0 > 0.0) {
+        return None;
+    }
+    let cut = (1..values.len())
+        .find(|&t| !(values[t].0 >= gap_ratio * values[t - 1].0) || !(values[t].0 > 0.0))
+        .unwrap_or(values.len());
+    Some(cut)
+}
+
+/// The nodes of A and of B whose candidate list in [`discretise`] is longer than
+/// `max_symmetry_order` (they stay unmatched): when no match is left, the parameters to
+/// change are `gap_ratio` and `max_symmetry_order` if these are many.
+pub fn overlong_lists(
+    scores: &[f64],
+    (n_a, n_b): (usize, usize),
+    gap_ratio: f64,
+    max_symmetry_order: usize,
+) -> usize {
+    let overlong = |values: &mut Vec<(f64, usize)>| {
+        list_length(values, gap_ratio).is_some_and(|cut| cut > max_symmetry_order)
+    };
+    let mut values = Vec::with_capacity(n_a.max(n_b));
+    let mut count = 0;
+    for i in 0..n_a {
+        values.clear();
+        values.extend((0..n_b).map(|j| (scores[i * n_b + j], j)));
+        count += usize::from(overlong(&mut values));
+    }
+    for j in 0..n_b {
+        values.clear();
+        values.extend((0..n_a).map(|i| (scores[i * n_b + j], i)));
+        count += usize::from(overlong(&mut values));
+    }
+    count
+}
+
 /// Discretisation (paper, end of section 5.1; docs/design.md, step 11). For every node of A, its
 /// scores over B sorted high to low (ties by index) are cut before the first value below
 /// `gap_ratio` times the previous one (the end of the row counts as a cut; a zero score
@@ -757,21 +797,10 @@ pub fn discretise(
         "discretise: scores must be n_a * n_b"
     );
     let pick = |values: &mut Vec<(f64, usize)>| -> Vec<usize> {
-        values.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
-        if values.is_empty() || !(values[0].0 > 0.0) {
-            return Vec::new();
+        match list_length(values, gap_ratio) {
+            Some(cut) if cut <= max_symmetry_order => values[..cut].iter().map(|v| v.1).collect(),
+            _ => Vec::new(),
         }
-        let mut cut = values.len();
-        for t in 1..values.len() {
-            if !(values[t].0 >= gap_ratio * values[t - 1].0) || !(values[t].0 > 0.0) {
-                cut = t;
-                break;
-            }
-        }
-        if cut > max_symmetry_order {
-            return Vec::new();
-        }
-        values[..cut].iter().map(|v| v.1).collect()
     };
     let mut from_a = vec![false; n_a * n_b];
     let mut values = Vec::with_capacity(n_a.max(n_b));

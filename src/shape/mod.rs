@@ -219,6 +219,8 @@ pub struct Shape {
     representative: Vec<u32>,
     n_pieces: usize,
     warnings: Vec<Warning>,
+    /// [`Shape::fingerprint`], computed on first use.
+    fingerprint: std::sync::OnceLock<u64>,
 }
 
 impl Shape {
@@ -327,6 +329,7 @@ impl Shape {
             representative,
             n_pieces: 0,
             warnings,
+            fingerprint: std::sync::OnceLock::new(),
         };
         match kind {
             ShapeKind::Mesh => {
@@ -563,6 +566,35 @@ impl Shape {
     /// Number of connected pieces (of the surface, or of the point cloud's kNN graph).
     pub fn n_pieces(&self) -> usize {
         self.n_pieces
+    }
+
+    /// A 64-bit hash of the vertex positions, the triangles and the kind, computed once: two
+    /// shapes with the same vertex count but other positions or faces (another shape, or A
+    /// and B swapped) differ, so a map can check that it is given the shapes it was made
+    /// from. Not stable across Rust versions (std's SipHash): never store it.
+    pub fn fingerprint(&self) -> u64 {
+        *self.fingerprint.get_or_init(|| {
+            use std::hash::{DefaultHasher, Hasher};
+            let mut hasher = DefaultHasher::new();
+            hasher.write_u8(self.kind as u8);
+            hasher.write_usize(self.vertices.len());
+            for p in &self.vertices {
+                let mut bytes = [0u8; 24];
+                for (c, x) in p.iter().enumerate() {
+                    bytes[8 * c..8 * c + 8].copy_from_slice(&x.to_bits().to_le_bytes());
+                }
+                hasher.write(&bytes);
+            }
+            hasher.write_usize(self.triangles.len());
+            for t in &self.triangles {
+                let mut bytes = [0u8; 12];
+                for (c, v) in t.iter().enumerate() {
+                    bytes[4 * c..4 * c + 4].copy_from_slice(&v.to_le_bytes());
+                }
+                hasher.write(&bytes);
+            }
+            hasher.finish()
+        })
     }
 
     /// What was repaired or ignored while building the shape.

@@ -11,11 +11,11 @@
 //! So B's seam runs along B's edges nearest A's seam, and no triangle of B spans a seam
 //! (which would smear it across the texture).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use crate::maps::surface::SurfaceMap;
 use crate::shape::surface_point::closest_on_triangle;
-use crate::shape::Shape;
+use crate::shape::{Shape, ShapeKind};
 use crate::{Error, Result};
 
 /// Corner values closer than this are the same value (an edge between them is no seam).
@@ -265,6 +265,22 @@ fn check(
             ),
         ));
     }
+    if a.fingerprint() != map.fingerprint_a {
+        return Err(invalid(
+            "a",
+            "is not the shape A the surface map was made from (same vertex count, other \
+             positions or faces)"
+                .into(),
+        ));
+    }
+    if a.kind() == ShapeKind::PointCloud {
+        return Err(invalid(
+            "a",
+            "is a point cloud: per-corner values need A's triangles (carry per-vertex values \
+             with transfer)"
+                .into(),
+        ));
+    }
     if let Some(t) = faces_a
         .iter()
         .find(|t| t.iter().any(|&v| v as usize >= a.n_vertices()))
@@ -277,6 +293,7 @@ fn check(
             ),
         ));
     }
+    check_faces_of(a, faces_a)?;
     let n_b = map.points.len();
     if let Some(t) = faces_b
         .iter()
@@ -309,6 +326,46 @@ fn check(
                 values[i]
             ),
         ));
+    }
+    Ok(())
+}
+
+/// `faces_a` must be the triangles `a` was made from: every one of them (by its corners'
+/// representatives, in any order and orientation), and no other. A face with a repeated
+/// corner is passed over, as the shape dropped it.
+fn check_faces_of(a: &Shape, faces_a: &[[u32; 3]]) -> Result<()> {
+    let invalid = |reason: String| Error::InvalidParameter {
+        name: "faces_a",
+        reason,
+    };
+    if faces_a.is_empty() {
+        return Err(invalid(
+            "is empty: give the triangles `a` was made from, with their corner values".into(),
+        ));
+    }
+    let representative = a.representative();
+    let key = |t: &[u32; 3]| -> Option<[u32; 3]> {
+        let mut k = t.map(|v| representative[v as usize]);
+        k.sort_unstable();
+        (k[0] != k[1] && k[1] != k[2]).then_some(k)
+    };
+    let own: HashSet<[u32; 3]> = a.triangles().iter().filter_map(key).collect();
+    let mut seen = HashSet::with_capacity(own.len());
+    for (i, t) in faces_a.iter().enumerate() {
+        let Some(k) = key(t) else { continue };
+        if !own.contains(&k) {
+            return Err(invalid(format!(
+                "triangle {i} {t:?} is not a triangle of `a`: give the triangles `a` was made from"
+            )));
+        }
+        seen.insert(k);
+    }
+    if seen.len() != own.len() {
+        return Err(invalid(format!(
+            "holds {} of the {} triangles of `a`: give every triangle `a` was made from",
+            seen.len(),
+            own.len()
+        )));
     }
     Ok(())
 }

@@ -44,22 +44,48 @@ impl SurfaceMap {
                 out.extend_from_slice(row(point.nearest()));
                 continue;
             }
-            mean.fill(0.0);
-            for (&v, &w) in point.vertices.iter().zip(&point.weights) {
-                if w > 0.0 {
-                    mean.iter_mut().zip(row(v)).for_each(|(m, x)| *m += w * x);
-                }
+            let rows = point.vertices.map(row);
+            for (c, m) in mean.iter_mut().enumerate() {
+                *m = weighted_mean(rows.map(|r| r[c]), point.weights);
             }
             if let TransferMode::Weights { max_influences } = mode {
                 keep_largest(&mut mean, max_influences);
-                let total: f64 = mean.iter().sum();
-                if total > 0.0 {
-                    mean.iter_mut().for_each(|w| *w /= total);
-                }
+                scale_to_one(&mut mean);
             }
             out.extend_from_slice(&mean);
         }
         Ok(out)
+    }
+}
+
+/// `sum_i w_i x_i` for weights summing to 1 (heaviest first), as `x_0 + sum_i w_i (x_i -
+/// x_0)`: a constant stays exactly itself, and a mean of finite values stays finite (values
+/// near `f64::MAX` of both signs are scaled by the largest first).
+fn weighted_mean(x: [f64; 3], w: [f64; 3]) -> f64 {
+    let offset: f64 = (1..3)
+        .filter(|&i| w[i] > 0.0)
+        .map(|i| w[i] * (x[i] - x[0]))
+        .sum();
+    let mean = x[0] + offset;
+    if mean.is_finite() {
+        return mean;
+    }
+    let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    scale
+        * (0..3)
+            .filter(|&i| w[i] > 0.0)
+            .map(|i| w[i] * (x[i] / scale))
+            .sum::<f64>()
+}
+
+/// Scales non-negative weights to sum to 1, dividing by the largest first so that the sum
+/// stays finite for weights near `f64::MAX`; a row of zeros stays zeros.
+fn scale_to_one(weights: &mut [f64]) {
+    let largest = weights.iter().fold(0.0_f64, |m, &w| m.max(w));
+    if largest > 0.0 {
+        weights.iter_mut().for_each(|w| *w /= largest);
+        let total: f64 = weights.iter().sum();
+        weights.iter_mut().for_each(|w| *w /= total);
     }
 }
 

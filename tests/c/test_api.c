@@ -1237,6 +1237,160 @@ done:
     sc_shape_free(other);
 }
 
+/* Frees `handle` (of the kind `free_fn` frees) at the first progress report. */
+struct free_at_report {
+    void *handle;
+    void (*free_fn)(void *);
+    int reports;
+};
+
+static bool free_at_first_report(void *userdata, uint32_t stage, float fraction) {
+    struct free_at_report *f = userdata;
+    (void)stage;
+    (void)fraction;
+    if (f->reports++ == 0)
+        f->free_fn(f->handle);
+    return true;
+}
+
+static void free_shape(void *h) { sc_shape_free(h); }
+static void free_params(void *h) { sc_params_free(h); }
+static void free_pointwise(void *h) { sc_pointwise_free(h); }
+
+/* A handle freed while a call uses it (from the call's own progress callback) stays alive
+ * until the call returns: the call's answer is whole, and valgrind sees no read of freed
+ * memory (before handles were counted: a PANIC status reading the freed shape). */
+static void test_handles_in_use(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 3), *a2 = figure("humanoid", 0);
+    sc_params *params = pointwise_params();
+    sc_correspondence *c = NULL;
+    sc_pointwise *p = NULL;
+    sc_surface_map *m = NULL;
+    size_t na = sc_shape_n_vertices(a), nb = sc_shape_n_vertices(b);
+    sc_symmetry *s = NULL;
+    struct free_at_report f = {NULL, free_shape, 0};
+    f.handle = a;
+    CHECK_STATUS(sc_match(a, b, NULL, free_at_first_report, &f, &c), SC_STATUS_OK);
+    CHECK(f.reports > 1, "freed at the first of %d reports", f.reports);
+    CHECK(sc_correspondence_n_vertices(c, SC_SIDE_A) == na, "regions of every vertex of A");
+    f.handle = params, f.free_fn = free_params, f.reports = 0;
+    CHECK_STATUS(sc_pointwise_map(a2, b, params, free_at_first_report, &f, &p), SC_STATUS_OK);
+    CHECK(f.reports > 1 && sc_pointwise_n_vertices(p, SC_SIDE_B) == nb, "a map of B");
+    f.handle = p, f.free_fn = free_pointwise, f.reports = 0;
+    CHECK_STATUS(sc_surface_map_new(a2, b, p, free_at_first_report, &f, &m), SC_STATUS_OK);
+    CHECK(f.reports > 0 && sc_surface_map_n_vertices(m, SC_SIDE_B) == nb, "surface map made");
+    f.handle = b, f.free_fn = free_shape, f.reports = 0;
+    CHECK_STATUS(sc_symmetry_detect(b, NULL, free_at_first_report, &f, &s), SC_STATUS_OK);
+    CHECK(f.reports > 1 && sc_symmetry_n_vertices(s) == nb, "symmetry of every vertex");
+    sc_symmetry_free(s);
+    sc_surface_map_free(m);
+    sc_correspondence_free(c);
+    sc_shape_free(a2);
+}
+
+/* A surface map checks its shapes by their positions and faces, not only their counts. */
+static void test_surface_map_shapes(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 3), *c = figure("humanoid", 5);
+    sc_params *params = pointwise_params();
+    sc_pointwise *p = NULL;
+    sc_surface_map *m = NULL, *sentinel = (sc_surface_map *)&m;
+    size_t na = sc_shape_n_vertices(a), nb = sc_shape_n_vertices(b), i;
+    size_t nta = sc_shape_n_triangles(a), ntb = sc_shape_n_triangles(b);
+    uint32_t *faces_a = malloc(3 * nta * sizeof *faces_a), *faces_b = malloc(3 * ntb * sizeof *faces_b);
+    uint32_t *nearest = malloc(nb * sizeof *nearest), *corners = malloc(3 * nb * sizeof *corners);
+    double *values = malloc(4 * na * sizeof *values), *out = malloc(4 * nb * sizeof *out);
+    double *corner_a = calloc(3 * nta, sizeof *corner_a), *corner_b = malloc(3 * ntb * sizeof *corner_b);
+    double *weights = malloc(3 * nb * sizeof *weights);
+    CHECK(na == nb && sc_shape_n_vertices(c) == na, "three figures of one size");
+    CHECK_STATUS(sc_pointwise_map(a, b, params, NULL, NULL, &p), SC_STATUS_OK);
+    m = sentinel;
+    CHECK_STATUS(sc_surface_map_new(b, a, p, NULL, NULL, &m), SC_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(sc_last_error(), "swapped") != NULL, "message: %s", sc_last_error());
+    CHECK_STATUS(sc_surface_map_new(c, b, p, NULL, NULL, &m), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_surface_map_new(a, c, p, NULL, NULL, &m), SC_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(sc_last_error(), "not the shape B") != NULL, "message: %s", sc_last_error());
+    CHECK(m == sentinel, "nothing written on failure");
+    CHECK_STATUS(sc_surface_map_new(a, b, p, NULL, NULL, &m), SC_STATUS_OK);
+    if (m == sentinel) m = NULL;
+    CHECK_STATUS(sc_shape_triangles(a, faces_a, 3 * nta), SC_STATUS_OK);
+    CHECK_STATUS(sc_shape_triangles(b, faces_b, 3 * ntb), SC_STATUS_OK);
+    /* Per-corner transfer: A's faces required, all of them, and A itself. */
+    for (i = 0; i < 3 * ntb; i++) corner_b[i] = -7.0;
+    CHECK_STATUS(sc_surface_map_transfer_corners(m, a, faces_a, 0, NULL, 0, faces_b, 3 * ntb, 1,
+                                                 corner_b, 3 * ntb),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "empty") != NULL, "message: %s", sc_last_error());
+    CHECK(corner_b[0] == -7.0, "output untouched");
+    CHECK_STATUS(sc_surface_map_transfer_corners(m, c, faces_a, 3 * nta, corner_a, 3 * nta,
+                                                 faces_b, 3 * ntb, 1, corner_b, 3 * ntb),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "not the shape A") != NULL, "message: %s", sc_last_error());
+    CHECK_STATUS(sc_surface_map_transfer_corners(m, a, faces_a + 3, 3 * nta - 3, corner_a + 3,
+                                                 3 * nta - 3, faces_b, 3 * ntb, 1, corner_b, 3 * ntb),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "every triangle") != NULL, "message: %s", sc_last_error());
+    CHECK_STATUS(sc_surface_map_transfer_corners(m, a, faces_a, 3 * nta, corner_a, 3 * nta,
+                                                 faces_b, 3 * ntb, 1, corner_b, 3 * ntb),
+                 SC_STATUS_OK);
+    /* Values near the largest double: a constant stays itself, skin weights sum to 1. */
+    for (i = 0; i < 4 * na; i++) values[i] = 1.7e308;
+    CHECK_STATUS(sc_surface_map_transfer(m, values, 4 * na, 4, SC_TRANSFER_INTERPOLATE, 0, out,
+                                         4 * nb),
+                 SC_STATUS_OK);
+    for (i = 0; i < 4 * nb; i++) CHECK(out[i] == 1.7e308, "constant at %zu: %g", i, out[i]);
+    CHECK_STATUS(sc_surface_map_transfer(m, values, 4 * na, 4, SC_TRANSFER_WEIGHTS, 0, out, 4 * nb),
+                 SC_STATUS_OK);
+    for (i = 0; i < nb; i++) {
+        double sum = out[4 * i] + out[4 * i + 1] + out[4 * i + 2] + out[4 * i + 3];
+        CHECK(fabs(sum - 1.0) < 1e-12, "row %zu sums to %g", i, sum);
+    }
+    /* The nearest vertex is the heaviest of the three, as SC_TRANSFER_NEAREST reads it. */
+    CHECK_STATUS(sc_surface_map_nearest(m, nearest, nb - 1), SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_surface_map_nearest(m, nearest, nb), SC_STATUS_OK);
+    CHECK_STATUS(sc_surface_map_points(m, corners, weights, 3 * nb), SC_STATUS_OK);
+    for (i = 0; i < nb; i++) CHECK(nearest[i] == corners[3 * i], "nearest of %zu", i);
+    sc_surface_map_free(m);
+    sc_pointwise_free(p);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+    sc_shape_free(c);
+    free(faces_a);
+    free(faces_b);
+    free(nearest);
+    free(corners);
+    free(values);
+    free(out);
+    free(corner_a);
+    free(corner_b);
+    free(weights);
+}
+
+/* Too small a gap ratio leaves every region with too many candidates: an error that names
+ * gap_ratio, never a success with no match; 0 (in the documented range [0, 1]) is taken. */
+static void test_no_match_is_an_error(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 3);
+    sc_params *params = NULL;
+    sc_correspondence *c = NULL;
+    sc_pointwise *p = NULL;
+    double values[] = {1e-20, 0.0};
+    size_t i;
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_bool(params, "verify_hypotheses", false), SC_STATUS_OK);
+    for (i = 0; i < 2; i++) {
+        CHECK_STATUS(sc_params_set_double(params, "gap_ratio", values[i]), SC_STATUS_OK);
+        CHECK_STATUS(sc_match(a, b, params, NULL, NULL, &c), SC_STATUS_INVALID_PARAMETER);
+        CHECK(strstr(sc_last_error(), "gap_ratio") && strstr(sc_last_error(), "no region"),
+              "message: %s", sc_last_error());
+        CHECK_STATUS(sc_pointwise_map(a, b, params, NULL, NULL, &p), SC_STATUS_INVALID_PARAMETER);
+        CHECK(strstr(sc_last_error(), "gap_ratio") != NULL, "message: %s", sc_last_error());
+    }
+    CHECK(c == NULL && p == NULL, "nothing written");
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
 /* ---------------------------------------------------------------- collections */
 
 /* Writes `shape` as an OFF file. */
@@ -1354,6 +1508,9 @@ static const struct {
     {"pointwise_permuted_copy", test_pointwise_permuted_copy},
     {"pointwise_cancellation", test_pointwise_cancellation},
     {"transfer", test_transfer},
+    {"handles_in_use", test_handles_in_use},
+    {"surface_map_shapes", test_surface_map_shapes},
+    {"no_match_is_an_error", test_no_match_is_an_error},
     {"batch", test_batch},
     {"concurrency", test_concurrency},
 };

@@ -390,3 +390,40 @@ fn awkward_but_valid_inputs_give_an_answer_or_a_typed_error_never_a_panic() {
         }
     }
 }
+
+/// An answer with no region matched is an error that names `gap_ratio` (a tiny gap ratio
+/// leaves every region with more candidates than `max_symmetry_order`), never a success
+/// with zero matches; 0 is in the option's range [0, 1] and fails the same way.
+#[test]
+fn no_matched_region_is_an_error_naming_gap_ratio() {
+    let a = humanoid(0, 800, Proportions::default());
+    let b = humanoid(3, 800, Proportions::default());
+    let a = Shape::mesh(a.vertices, &a.triangles).unwrap();
+    let b = Shape::mesh(b.vertices, &b.triangles).unwrap();
+    for gap_ratio in [1e-20, 0.0] {
+        let mut params = Params {
+            verify_hypotheses: false,
+            ..Params::default()
+        };
+        params.matching.gap_ratio = gap_ratio;
+        let err = Correspondence::compute(&a, &b, &params, &mut NoProgress).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::InvalidParameter {
+                    name: "gap_ratio",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        let message = err.to_string();
+        assert!(message.contains("no region") && message.contains("max_symmetry_order"));
+    }
+    let params = Params {
+        verify_hypotheses: false,
+        ..Params::default()
+    };
+    let result = Correspondence::compute(&a, &b, &params, &mut NoProgress).unwrap();
+    assert!(!result.matches.is_empty());
+}

@@ -449,3 +449,67 @@ fn texture_coordinates_keep_their_seams() {
     // No seam that A does not have: B's seam is about as long as its true layout's.
     assert!(seams[1] <= 2 * seams[2], "{seams:?}");
 }
+
+/// Two poses of one figure (the same vertex order) and the identity map between them:
+/// a surface map without the cost of a pointwise map.
+fn identity_map(n: usize) -> (Shape, Shape, SurfaceMap) {
+    let rig = synth::rig(FigureKind::Humanoid, n).unwrap();
+    let a = Shape::mesh(rig.rest.vertices.clone(), &rig.rest.triangles).unwrap();
+    let posed = rig.deform(&rig.weights, b_body(), 2).unwrap();
+    let b = Shape::mesh(posed, &rig.rest.triangles).unwrap();
+    let identity: Vec<u32> = (0..b.n_vertices() as u32).collect();
+    let map = SurfaceMap::from_vertex_map(&a, &b, &identity, &mut NoProgress).unwrap();
+    (a, b, map)
+}
+
+/// Values near `f64::MAX`: a constant is carried exactly, skin weights keep rows that sum
+/// to 1 (they summed to infinity and became zeros), values of both signs stay finite.
+#[test]
+fn values_near_the_largest_double_stay_finite() {
+    let (a, _, map) = identity_map(800);
+    let n = a.n_vertices();
+    let constant = vec![1.7e308; 4 * n];
+    let out = map
+        .transfer(&constant, 4, TransferMode::Interpolate)
+        .unwrap();
+    assert!(out.iter().all(|&x| x == 1.7e308));
+    let weights = map
+        .transfer(&constant, 4, TransferMode::Weights { max_influences: 0 })
+        .unwrap();
+    for row in weights.chunks(4) {
+        assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{row:?}");
+    }
+    let signs: Vec<f64> = (0..n)
+        .map(|v| if v % 2 == 0 { 1.7e308 } else { -1.7e308 })
+        .collect();
+    let out = map.transfer(&signs, 1, TransferMode::Interpolate).unwrap();
+    assert!(out.iter().all(|x| x.is_finite() && x.abs() <= 1.7e308));
+}
+
+/// Per-corner values need A's own triangles, every one of them, and A itself.
+#[test]
+fn per_corner_transfer_refuses_no_faces_missing_faces_and_another_a() {
+    let (a, b, map) = identity_map(800);
+    let faces_a = a.triangles().to_vec();
+    let faces_b = b.triangles().to_vec();
+    let values = vec![0.5; faces_a.len() * 3];
+    let message = |shape: &Shape, faces: &[[u32; 3]], values: &[f64]| {
+        map.transfer_corners((shape, faces), values, &faces_b, 1)
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(message(&a, &[], &[]).contains("empty"));
+    assert!(message(&a, &faces_a[1..], &values[3..]).contains("every triangle"));
+    // A triangle of A's first two corners and a vertex far away (the middle triangle's).
+    let mut foreign = faces_a.clone();
+    foreign[0][2] = faces_a[faces_a.len() / 2][0];
+    assert!(!foreign[0].contains(&faces_a[0][2]) && foreign[0][2] != foreign[0][0]);
+    assert!(message(&a, &foreign, &values).contains("not a triangle"));
+    // B has A's vertex count and faces but other positions.
+    assert_eq!(b.n_vertices(), a.n_vertices());
+    assert!(message(&b, &faces_a, &values).contains("not the shape A"));
+    let out = map
+        .transfer_corners((&a, &faces_a), &values, &faces_b, 1)
+        .unwrap();
+    assert!(out.iter().all(|&x| (x - 0.5).abs() < 1e-12));
+}

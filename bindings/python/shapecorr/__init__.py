@@ -227,7 +227,12 @@ def _fill(function, handle, *args, shape, dtype, ctype):
 
 
 class _Handle:
-    """Owns a C handle; freed when the object is collected or at interpreter exit."""
+    """Owns a C handle; freed when the object is collected or at interpreter exit.
+
+    Every library call that takes the object counts as a use (``_lib`` wraps each call in
+    :meth:`_acquire` and :meth:`_release`): :meth:`close` during a use, from a progress
+    callback or another thread, frees the C object only when the last use ends, so a
+    running call never reads freed memory."""
 
     _free = None
 
@@ -235,22 +240,45 @@ class _Handle:
         self._pointer = ctypes.c_void_p(pointer)
         # finalize keeps a reference to the free function, so it works at exit too.
         self._finalizer = weakref.finalize(self, type(self)._free, self._pointer)
+        self._lock = threading.Lock()
+        self._uses = 0
+        self._closing = False
+
+    def _acquire(self):
+        """Counts a use; ValueError once :meth:`close` was called."""
+        with self._lock:
+            if self._closing or not self._finalizer.alive:
+                raise ValueError(f"this {type(self).__name__} is closed")
+            self._uses += 1
+
+    def _release(self):
+        """Ends a use; frees the C object when it was closed meanwhile and this was the last."""
+        with self._lock:
+            self._uses -= 1
+            free = self._closing and self._uses == 0
+        if free:
+            self._finalizer()
 
     def _handle_pointer(self):
-        """The C pointer; ValueError once :meth:`close` freed it (never a dangling one)."""
-        if not self._finalizer.alive:
+        """The C pointer; ValueError once :meth:`close` was called (never a dangling one)."""
+        if self.closed:
             raise ValueError(f"this {type(self).__name__} is closed")
         return self._pointer
 
     @property
     def closed(self) -> bool:
-        """True once :meth:`close` freed the C object."""
-        return not self._finalizer.alive
+        """True once :meth:`close` was called."""
+        return self._closing or not self._finalizer.alive
 
     def close(self) -> None:
-        """Frees the C object now (also done automatically); using it afterwards raises
-        ValueError."""
-        self._finalizer()
+        """Frees the C object (also done automatically): now, or when a call still using it
+        returns (``close()`` from a progress callback or another thread); using it
+        afterwards raises ValueError."""
+        with self._lock:
+            self._closing = True
+            free = self._uses == 0
+        if free:
+            self._finalizer()
 
 
 def _expect(value, kind, name):
@@ -500,17 +528,41 @@ class _Params(_Handle):
                 "float": lib.sc_params_set_double,
                 "bool": lib.sc_params_set_bool,
             }[kind]
-            if kind == "int" and (isinstance(value, (bool, str, bytes)) or int(value) != value):
+            if kind == "int" and not _is_integer(value):
                 names = f" or one of {', '.join(map(repr, choices))}" if choices else ""
-                raise ShapecorrError(2, f"option `{name}` takes an integer{names}, got {value!r}")
+                raise _OptionTypeError(2, f"option `{name}` takes an integer{names}, got {value!r}")
+            if kind == "float" and not _is_real(value):
+                raise _OptionTypeError(2, f"option `{name}` takes a number, got {value!r}")
             if kind == "int" and name == "seed" and 2**63 <= int(value) < 2**64:
                 value = int(value) - 2**64  # a seed takes any 64-bit value
             if kind == "int" and not -(2**63) <= int(value) < 2**63:
                 raise OverflowError(f"option `{name}`: {value} does not fit in 64 bits")
             if kind == "bool" and not isinstance(value, (bool, np.bool_)):
-                raise ShapecorrError(2, f"option `{name}` takes True or False, got {value!r}")
+                raise _OptionTypeError(2, f"option `{name}` takes True or False, got {value!r}")
             converted = {"int": int, "float": float, "bool": bool}[kind](value)
             _check(setter(self, name.encode(), converted))
+
+
+class _OptionTypeError(ShapecorrError, TypeError):
+    """An option given a value of the wrong type (a string for a number, a bool for an
+    integer): status ``INVALID_ARGUMENT``, and a TypeError too."""
+
+
+def _is_integer(value):
+    """An int, a numpy integer or a float with an integer value (a bool or a string is
+    not)."""
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    if isinstance(value, (float, np.floating)):
+        return math.isfinite(value) and float(value).is_integer()
+    return isinstance(value, (int, np.integer))
+
+
+def _is_real(value):
+    """An int, a float or a numpy number that is no bool (a string is no number)."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
 
 
 _OPTION_KINDS: dict[int, OptionKind] = {
@@ -654,6 +706,8 @@ def _warning(text):
 
 
 def _side(side):
+    if isinstance(side, (bool, np.bool_)) or not isinstance(side, (str, int, np.integer)):
+        raise TypeError(f"side must be 'a' or 'b' (or 0, 1), got {side!r}")
     if side in ("a", "A", 0):
         return _lib.SIDE_A
     if side in ("b", "B", 1):
@@ -937,19 +991,40 @@ class SurfaceMap(_Handle):
         ))
         return vertices, weights
 
+    @property
+    def nearest(self) -> NDArray[np.uint32]:
+        """For every vertex of B, the vertex of A whose value ``mode="nearest"`` takes
+        (uint32, ``(n_vertices_b,)``)."""
+        return _fill(
+            lib.sc_surface_map_nearest, self, shape=self.n_vertices_b, dtype=np.uint32,
+            ctype=ctypes.c_uint32,
+        )
+
     def transfer(
         self, values: ArrayLike, mode: TransferMode = "interpolate", max_influences: int = 0
-    ) -> NDArray[np.float64]:
+    ) -> NDArray[Any]:
         """``values`` on A's vertices (``(n_vertices_a,)`` or ``(n_vertices_a, channels)``)
-        carried to B's vertices, same dimensionality, float64. ``mode``: ``"interpolate"``
+        carried to B's vertices, same dimensionality. ``mode``: ``"interpolate"``
         (continuous data), ``"nearest"`` (labels, ids) or ``"weights"`` (skin weights:
         non-negative rows, at most ``max_influences`` kept (0: all), each row of B summing
-        to 1)."""
+        to 1). The result is float64, except in ``"nearest"`` mode for values that are not
+        floats (integers of any size, bools, strings): these are copied exactly, in their
+        own dtype (an id above 2**53 stays itself). Numbers only in the other modes
+        (TypeError for strings or objects)."""
         if mode not in _lib.TRANSFER_MODES:
             raise ValueError(f"mode must be one of {sorted(_lib.TRANSFER_MODES)}, got {mode!r}")
-        values = np.ascontiguousarray(values, dtype=np.float64)
-        if values.ndim not in (1, 2):
-            raise ValueError(f"values must be 1-D or 2-D, got shape {values.shape}")
+        given = np.asarray(values)
+        if given.ndim not in (1, 2):
+            raise ValueError(f"values must be 1-D or 2-D, got shape {given.shape}")
+        if mode == "nearest" and given.dtype.kind not in "fc":
+            if given.shape[0] != self.n_vertices_a:
+                raise ValueError(
+                    f"values has {given.shape[0]} rows, A has {self.n_vertices_a} vertices"
+                )
+            return given[self.nearest]
+        if given.dtype.kind not in "biuf":
+            raise TypeError(f"values must be numbers, got an array of {given.dtype}")
+        values = np.ascontiguousarray(given, dtype=np.float64)
         channels = 1 if values.ndim == 1 else values.shape[1]
         shape = (self.n_vertices_b,) if values.ndim == 1 else (self.n_vertices_b, channels)
         out = np.empty(shape, dtype=np.float64)
@@ -967,11 +1042,15 @@ class SurfaceMap(_Handle):
         B's triangles ``faces_b``, seams kept (texture coordinates: a UV island of A stays
         one island on B, no triangle of B spans A's seam). ``corner_values`` is
         ``(n_a_triangles, 3)`` or ``(n_a_triangles, 3, channels)``; the result is float64,
-        ``(n_b_triangles, 3)`` or ``(n_b_triangles, 3, channels)``."""
+        ``(n_b_triangles, 3)`` or ``(n_b_triangles, 3, channels)``. Face indices must be
+        integers (TypeError for floats) in the range of uint32 (ValueError)."""
         _expect(a, Shape, "a")
-        faces_a = np.ascontiguousarray(faces_a, dtype=np.uint32)
-        faces_b = np.ascontiguousarray(faces_b, dtype=np.uint32)
-        values = np.ascontiguousarray(corner_values, dtype=np.float64)
+        faces_a = _faces(faces_a, "faces_a")
+        faces_b = _faces(faces_b, "faces_b")
+        values = np.asarray(corner_values)
+        if values.dtype.kind not in "biuf":
+            raise TypeError(f"corner_values must be numbers, got an array of {values.dtype}")
+        values = np.ascontiguousarray(values, dtype=np.float64)
         if values.ndim not in (2, 3) or values.shape[:2] != (len(faces_a), 3):
             raise ValueError(f"corner_values must be ({len(faces_a)}, 3[, channels]), got {values.shape}")
         channels = 1 if values.ndim == 2 else values.shape[2]
@@ -986,6 +1065,21 @@ class SurfaceMap(_Handle):
 
     def __repr__(self) -> str:
         return f"<shapecorr.SurfaceMap {self.n_vertices_b} vertices of B -> surface of A>"
+
+
+def _faces(faces, name):
+    """An (m, 3) array of vertex indices as contiguous uint32: TypeError for indices that are
+    not integers (floats would be truncated), ValueError for a wrong shape or an index
+    outside uint32 (a negative one would wrap)."""
+    faces = np.asarray(faces)
+    if faces.size and faces.dtype.kind not in "iu":
+        raise TypeError(f"{name} must hold integer vertex indices, got {faces.dtype}")
+    if faces.size and (faces.ndim != 2 or faces.shape[1] != 3):
+        raise ValueError(f"{name} must have shape (m, 3), got {faces.shape}")
+    if faces.size and (faces.min() < 0 or faces.max() > np.iinfo(np.uint32).max):
+        bad = faces.min() if faces.min() < 0 else faces.max()
+        raise ValueError(f"{name}: vertex index {bad} is out of range")
+    return np.ascontiguousarray(faces, dtype=np.uint32).reshape(-1, 3)
 
 
 def surface_map(

@@ -217,6 +217,7 @@ FUNCTIONS = {
     "sc_surface_map_free": (None, [handle]),
     "sc_surface_map_n_vertices": (c_size_t, [handle, u32_arg]),
     "sc_surface_map_points": (status, [handle, c_u32p, c_f64p, c_size_t]),
+    "sc_surface_map_nearest": (status, [handle, c_u32p, c_size_t]),
     "sc_surface_map_transfer": (
         status, [handle, c_f64p, c_size_t, c_size_t, u32_arg, u32_arg, c_f64p, c_size_t],
     ),
@@ -235,17 +236,28 @@ FUNCTIONS = {
 }
 
 def _raising_the_original(function):
-    """``function``, raising a checked argument's own error instead of ArgumentError."""
+    """``function``, raising a checked argument's own error instead of ArgumentError, with
+    every shapecorr object among its arguments counted as in use for the call (a ``close()``
+    meanwhile frees it only when the call returns)."""
 
     def call(*args):
         _argument_error.value = None
+        held = []
         try:
+            for arg in args:
+                acquire = getattr(arg, "_acquire", None)
+                if acquire is not None:
+                    acquire()
+                    held.append(arg)
             return function(*args)
         except ctypes.ArgumentError:
             error, _argument_error.value = getattr(_argument_error, "value", None), None
             if error is None:
                 raise
             raise error from None
+        finally:
+            for arg in held:
+                arg._release()
 
     call.__name__ = function.__name__
     call.restype, call.argtypes = function.restype, function.argtypes

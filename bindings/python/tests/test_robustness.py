@@ -170,3 +170,129 @@ def test_ctrl_c_during_a_call_cancels_and_raises_keyboard_interrupt(with_callbac
         latency = time.monotonic() - sent[0]
         assert latency < 2.0, f"stopped {latency:.2f} s after Ctrl-C"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_close_inside_a_progress_callback_waits_for_the_call(pair):
+    a = shapecorr.Shape.figure("humanoid", 0, SIZE)
+    _, b = pair
+    closed_during = []
+
+    def close_a(stage, fraction):
+        if not a.closed:
+            a.close()
+            closed_during.append(stage)
+        return True
+
+    # Before the use count: PANIC, "index out of bounds", reading the freed shape.
+    result = shapecorr.match(a, b, verify_hypotheses=False, progress=close_a)
+    assert closed_during and result.k >= 2
+    assert result.n_regions("a") == len(np.unique(result.regions_a))
+    with pytest.raises(ValueError, match="closed"):
+        a.n_vertices
+    with pytest.raises(ValueError, match="closed"):
+        shapecorr.match(a, b)
+
+
+def test_close_from_another_thread_during_a_call_frees_after_it(pair):
+    a = shapecorr.Shape.figure("humanoid", 0, SIZE)
+    _, b = pair
+    started = threading.Event()
+
+    def progress(stage, fraction):
+        started.set()
+        time.sleep(0.01)
+        return True
+
+    closer = threading.Thread(target=lambda: (started.wait(), a.close()))
+    closer.start()
+    pointwise = shapecorr.pointwise_map(a, b, progress=progress)
+    closer.join()
+    assert a.closed
+    assert len(pointwise.map_b_to_a) == b.n_vertices
+
+
+def test_a_string_or_a_bool_for_a_number_option_is_refused(pair):
+    a, b = pair
+    for bad in [dict(gap_ratio="0.5"), dict(gap_ratio=b"0.5"), dict(gap_ratio=True), dict(sigma=None)]:
+        with pytest.raises(TypeError, match="takes a number"):
+            shapecorr.match(a, b, **bad)
+        with pytest.raises(ShapecorrError) as error:
+            shapecorr.match(a, b, **bad)
+        assert error.value.status_name == "INVALID_ARGUMENT"
+    with pytest.raises(TypeError, match="takes an integer"):
+        shapecorr.match(a, b, k_max="8")
+
+
+def test_side_must_be_a_or_b_not_a_bool(pair):
+    a, b = pair
+    result = shapecorr.match(a, b, verify_hypotheses=False)
+    for bad in [True, False, np.True_, 1.0, None]:
+        with pytest.raises(TypeError, match="side"):
+            result.n_regions(bad)
+    assert result.n_regions(1) == result.n_regions("b")
+
+
+@pytest.fixture(scope="module")
+def onto(pair):
+    a, b = pair
+    return shapecorr.surface_map(a, b, shapecorr.pointwise_map(a, b))
+
+
+def test_float_or_negative_face_indices_are_refused_by_transfer_corners(pair, onto):
+    a, b = pair
+    fa, fb = a.triangles, b.triangles
+    values = np.zeros((len(fa), 3, 2))
+    with pytest.raises(TypeError, match="faces_a must hold integer"):
+        onto.transfer_corners(a, fa.astype(float) + 0.6, values, fb)
+    with pytest.raises(TypeError, match="faces_b must hold integer"):
+        onto.transfer_corners(a, fa, values, fb.astype(float))
+    negative = fb.astype(np.int64)
+    negative[0, 0] = -1
+    with pytest.raises(ValueError, match="out of range"):
+        onto.transfer_corners(a, fa, values, negative)
+    with pytest.raises(ShapecorrError, match="faces_a.*empty"):
+        onto.transfer_corners(a, np.zeros((0, 3), np.uint32), np.zeros((0, 3)), fb)
+
+
+def test_a_surface_map_refuses_swapped_or_other_shapes_of_the_same_size(pair):
+    a, b = pair
+    other = shapecorr.Shape.figure("humanoid", 5, SIZE)
+    assert other.n_vertices == a.n_vertices == b.n_vertices
+    pointwise = shapecorr.pointwise_map(a, b)
+    for wrong_a, wrong_b in [(b, a), (other, b), (a, other)]:
+        with pytest.raises(ShapecorrError, match="not the shape") as error:
+            shapecorr.surface_map(wrong_a, wrong_b, pointwise)
+        assert error.value.status_name == "INVALID_ARGUMENT"
+    with pytest.raises(ShapecorrError, match="swapped"):
+        shapecorr.surface_map(b, a, pointwise)
+    onto = shapecorr.surface_map(a, b, pointwise)
+    values = np.zeros((len(b.triangles), 3))
+    with pytest.raises(ShapecorrError, match="not the shape A"):
+        onto.transfer_corners(b, b.triangles, values, b.triangles)
+
+
+def test_nearest_keeps_integers_beyond_2_53_exact(pair, onto):
+    a, _ = pair
+    ids = np.arange(a.n_vertices, dtype=np.int64) + 2**53 + 1
+    carried = onto.transfer(ids, mode="nearest")
+    assert carried.dtype == np.int64
+    assert np.array_equal(carried, ids[onto.nearest])
+    # The same map as the library's own nearest mode on small integers (exact in float64).
+    small = onto.transfer(np.arange(a.n_vertices, dtype=np.float64), mode="nearest")
+    assert np.array_equal(small, onto.nearest)
+    labels = np.array([f"v{i}" for i in range(a.n_vertices)])
+    assert onto.transfer(labels, mode="nearest")[0] == labels[onto.nearest[0]]
+    with pytest.raises(TypeError, match="numbers"):
+        onto.transfer(labels)
+    with pytest.raises(ValueError, match="rows"):
+        onto.transfer(ids[:-1], mode="nearest")
+
+
+def test_skin_weights_near_the_largest_double_keep_rows_summing_to_1(pair, onto):
+    a, _ = pair
+    weights = np.full((a.n_vertices, 4), 1.7e308)
+    out = onto.transfer(weights, mode="weights")
+    assert np.isfinite(out).all()
+    assert np.allclose(out.sum(axis=1), 1.0)
+    constant = onto.transfer(np.full(a.n_vertices, 1.7e308))
+    assert (constant == 1.7e308).all()
