@@ -419,10 +419,28 @@ fn params(dir: &Path) {
     );
 }
 
+/// `read_pairs`: tab- and space-separated pair files, names with spaces, categories,
+/// comments, CRLF, a byte order mark, and malformed lines.
+fn pair_files(dir: &Path) {
+    let files: [(&str, &[u8]); 7] = [
+        ("tabs", b"# source\ttarget\tcategory\ntr_reg_000\ttr_reg_009\tsame_person\n"),
+        ("spaces", b"a b\nc d category\n\n  # comment\n"),
+        ("names-with-spaces", b"left arm\tright arm\nx--y\tz\tsplit\n"),
+        ("crlf-bom", b"\xEF\xBB\xBFa\tb\r\nc\td\r\n"),
+        ("one-field", b"a\tb\nlonely\n"),
+        ("empty-name", b"\tb\n"),
+        ("four-fields", b"a\tb\tc\td\n"),
+    ];
+    for (name, bytes) in files {
+        write(dir, "read_pairs", name, bytes);
+    }
+}
+
 fn main() {
     let dir = std::env::args().nth(1).unwrap_or_else(|| "corpus".into());
     let dir = Path::new(&dir);
     readers(dir);
     shape_targets(dir);
     params(dir);
+    pair_files(dir);
 }

@@ -198,6 +198,10 @@ typedef uint32_t sc_status;
 // enough: it may be used from several threads at once. Free it with `sc_batch_free`.
 typedef struct sc_batch sc_batch;
 
+// A batch's output folder, locked by this process (`sc_batch_open_folder`) until it is
+// freed with `sc_batch_folder_free` (or the process ends, also when killed).
+typedef struct sc_batch_folder sc_batch_folder;
+
 // A batch log line: a shape's (`sc_batch_prepare`) or a pair's (`sc_batch_match`). Free
 // it with `sc_batch_record_free`.
 typedef struct sc_batch_record sc_batch_record;
@@ -325,6 +329,35 @@ bool sc_batch_record_ok(const sc_batch_record *record);
 // # Safety
 // `record` NULL or live, and not passed to a call again.
 void sc_batch_record_free(sc_batch_record *record);
+
+// Opens the output folder `out_dir` (created if missing) for a batch with `batch`'s
+// settings, as `shapecorr batch --out` does: locks it, refuses a folder another run holds
+// or one whose `batch.json` records other settings, and records them on a first run. Keep
+// the folder until the batch's log is written, then free it.
+//
+// Errors: `SC_STATUS_FILE_ERROR` (held by another run, other settings, not writable).
+//
+// # Safety
+// `batch` live; `out_dir` a NUL-terminated path; `out_folder` writable.
+sc_status sc_batch_open_folder(const sc_batch *batch,
+                               const char *out_dir,
+                               sc_batch_folder **out_folder);
+
+// Releases a folder's lock (NULL is a no-op).
+//
+// # Safety
+// `folder` NULL or live, and not used again.
+void sc_batch_folder_free(sc_batch_folder *folder);
+
+// The pairs of the pair file at `path` as a record whose JSON is an array of
+// `{"a", "b", "category", "line"}` (the format is in docs/collections.md: tab-separated
+// fields, names may hold spaces).
+//
+// Errors: `SC_STATUS_FILE_ERROR` (unreadable, or a malformed line: the message names it).
+//
+// # Safety
+// `path` a NUL-terminated path; `out_record` writable.
+sc_status sc_batch_read_pairs(const char *path, sc_batch_record **out_record);
 
 // A short static description of a status code (`"unknown status"` for a number that is
 // not a status). Never free it.

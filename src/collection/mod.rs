@@ -17,7 +17,9 @@
 //! or on a Dask cluster) both run through here.
 
 pub mod cache;
+pub mod folder;
 pub mod log;
+pub mod pairs;
 
 use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
@@ -27,7 +29,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 pub use cache::{BasisCache, TimedBasis};
+pub use folder::{settings_json, OutputFolder};
 pub use log::ResultLog;
+pub use pairs::{parse_pairs, read_pairs, PairLine};
 
 use crate::options::Options;
 use crate::pipeline::multiresolution::working;
@@ -161,6 +165,10 @@ pub struct ShapeRecord {
     pub eigenbasis_s: f64,
     /// Seconds of this preparation (reading, proxy, eigenbasis or its loading).
     pub seconds: f64,
+    /// What went wrong with the cache (a damaged entry computed again, an entry that could
+    /// not be stored); the shape's work is right either way.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
 }
 
 /// One line of a batch's pair log: the result of a pair, or why there is none.
@@ -232,8 +240,9 @@ impl Batch {
             },
         };
         let eigen = job.eigen_params();
-        std::fs::create_dir_all(&settings.cache_dir)
-            .map_err(|e| Error::file(&settings.cache_dir, e.to_string()))?;
+        // A folder that cannot be made is reported by each shape's record (the cache is an
+        // optimisation: the batch runs without it).
+        let _ = std::fs::create_dir_all(&settings.cache_dir);
         Ok(Batch {
             cache: BasisCache {
                 dir: Some(settings.cache_dir.clone()),
@@ -305,6 +314,7 @@ impl Batch {
             .cache
             .basis_for_key(Some(&record.key), working, &self.eigen)?;
         record.computed = !timed.from_cache;
+        record.warning = timed.warning;
         record.eigenbasis_s = timed.seconds;
         Ok(PreparedShape {
             shape,
@@ -427,22 +437,50 @@ impl Batch {
     }
 }
 
-/// Where the map of pair (`a`, `b`) is written, relative to the log's folder.
+/// Where the map of pair (`a`, `b`) is written, relative to the log's folder:
+/// `maps/A--B.u32` with each name escaped ([`escape_name`]), so that distinct pairs never
+/// share a file.
 pub fn map_file(a: &str, b: &str) -> String {
-    let safe = |name: &str| name.replace(['/', '\\'], "__");
-    format!("maps/{}--{}.u32", safe(a), safe(b))
+    format!("maps/{}--{}.u32", escape_name(a), escape_name(b))
+}
+
+/// A shape name as a part of a file name, one-to-one: `%` and the characters a file name
+/// cannot hold (`/`, `\`, NUL, control characters) are written `%XX` (their UTF-8 bytes
+/// in hexadecimal), and so is a `-` next to another `-` or at either end. An escaped name
+/// then never holds `--` nor starts or ends with `-`, so `A--B` splits one way only.
+pub fn escape_name(name: &str) -> String {
+    let chars: Vec<char> = name.chars().collect();
+    let mut escaped = String::with_capacity(name.len());
+    for (i, &c) in chars.iter().enumerate() {
+        let lone_dash =
+            c == '-' && i > 0 && i + 1 < chars.len() && chars[i - 1] != '-' && chars[i + 1] != '-';
+        if matches!(c, '%' | '/' | '\\') || c.is_control() || (c == '-' && !lone_dash) {
+            let mut utf8 = [0u8; 4];
+            for byte in c.encode_utf8(&mut utf8).bytes() {
+                escaped.push_str(&format!("%{byte:02X}"));
+            }
+        } else {
+            escaped.push(c);
+        }
+    }
+    escaped
 }
 
 /// Writes a map as little-endian u32, one per vertex of B, atomically (a temporary file
-/// renamed into place).
+/// renamed into place; removed when either step fails).
 pub fn write_map(path: &Path, map: &[u32]) -> Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, e.to_string()))?;
     }
     let bytes: Vec<u8> = map.iter().flat_map(|v| v.to_le_bytes()).collect();
     let tmp = path.with_extension(format!("tmp{}-{}", std::process::id(), thread_number()));
-    std::fs::write(&tmp, &bytes).map_err(|e| Error::file(&tmp, e.to_string()))?;
-    std::fs::rename(&tmp, path).map_err(|e| Error::file(path, e.to_string()))
+    let written = std::fs::write(&tmp, &bytes)
+        .map_err(|e| Error::file(&tmp, e.to_string()))
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::file(path, e.to_string())));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
 }
 
 /// Reads a map written by [`write_map`].

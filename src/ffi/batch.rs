@@ -11,7 +11,10 @@ use super::boundary::{
 };
 use super::params::ScParams;
 use super::shape::input_path;
-use crate::collection::{Batch, BatchSettings, Outputs, Prepared, Reading, DEFAULT_MEMORY_BYTES};
+use crate::collection::{
+    read_pairs, Batch, BatchSettings, OutputFolder, Outputs, Prepared, Reading,
+    DEFAULT_MEMORY_BYTES,
+};
 use crate::options::Options;
 
 /// `sc_batch_new` flag: point-to-point maps too (as `sc_pointwise_map`), each written to
@@ -192,4 +195,64 @@ pub unsafe extern "C" fn sc_batch_record_ok(record: *const ScBatchRecord) -> boo
 #[no_mangle]
 pub unsafe extern "C" fn sc_batch_record_free(record: *mut ScBatchRecord) {
     free_handle(record);
+}
+
+/// A batch's output folder, locked by this process (`sc_batch_open_folder`) until it is
+/// freed with `sc_batch_folder_free` (or the process ends, also when killed).
+pub struct ScBatchFolder {
+    _folder: OutputFolder,
+}
+
+/// Opens the output folder `out_dir` (created if missing) for a batch with `batch`'s
+/// settings, as `shapecorr batch --out` does: locks it, refuses a folder another run holds
+/// or one whose `batch.json` records other settings, and records them on a first run. Keep
+/// the folder until the batch's log is written, then free it.
+///
+/// Errors: `SC_STATUS_FILE_ERROR` (held by another run, other settings, not writable).
+///
+/// # Safety
+/// `batch` live; `out_dir` a NUL-terminated path; `out_folder` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_batch_open_folder(
+    batch: *const ScBatch,
+    out_dir: *const c_char,
+    out_folder: *mut *mut ScBatchFolder,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_folder, "out_folder")?;
+        let batch = &handle(batch, "batch")?.batch;
+        let out_dir = input_path(out_dir, "out_dir")?;
+        let folder = OutputFolder::open(&out_dir, batch.settings())?;
+        give_handle(out_folder, ScBatchFolder { _folder: folder })
+    })
+}
+
+/// Releases a folder's lock (NULL is a no-op).
+///
+/// # Safety
+/// `folder` NULL or live, and not used again.
+#[no_mangle]
+pub unsafe extern "C" fn sc_batch_folder_free(folder: *mut ScBatchFolder) {
+    free_handle(folder);
+}
+
+/// The pairs of the pair file at `path` as a record whose JSON is an array of
+/// `{"a", "b", "category", "line"}` (the format is in docs/collections.md: tab-separated
+/// fields, names may hold spaces).
+///
+/// Errors: `SC_STATUS_FILE_ERROR` (unreadable, or a malformed line: the message names it).
+///
+/// # Safety
+/// `path` a NUL-terminated path; `out_record` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_batch_read_pairs(
+    path: *const c_char,
+    out_record: *mut *mut ScBatchRecord,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_record, "out_record")?;
+        let path = input_path(path, "path")?;
+        let pairs = read_pairs(&path)?;
+        give_record(out_record, &pairs, true)
+    })
 }

@@ -1473,6 +1473,37 @@ static void test_batch(void) {
     sc_batch_record_free(record);
     CHECK_STATUS(sc_batch_match(batch, NULL, a_path, "b", b_path, dir, &record),
                  SC_STATUS_NULL_ARGUMENT);
+
+    /* The output folder: held by one opener at a time, released by its free. */
+    {
+        sc_batch_folder *folder = NULL, *second = NULL;
+        char out[160], pairs[160];
+        FILE *f;
+        snprintf(out, sizeof out, "%s/out", dir);
+        CHECK_STATUS(sc_batch_open_folder(batch, out, NULL), SC_STATUS_NULL_ARGUMENT);
+        CHECK_STATUS(sc_batch_open_folder(batch, out, &folder), SC_STATUS_OK);
+        CHECK_STATUS(sc_batch_open_folder(batch, out, &second), SC_STATUS_FILE_ERROR);
+        CHECK(second == NULL, "no folder on failure");
+        sc_batch_folder_free(folder);
+        CHECK_STATUS(sc_batch_open_folder(batch, out, &second), SC_STATUS_OK);
+        sc_batch_folder_free(second);
+        sc_batch_folder_free(NULL);
+
+        /* Pair files: tab-separated names may hold spaces. */
+        snprintf(pairs, sizeof pairs, "%s/pairs.txt", dir);
+        f = fopen(pairs, "w");
+        CHECK(f != NULL, "%s", pairs);
+        if (f) {
+            fputs("# a\tb\nleft arm\tb\n", f);
+            fclose(f);
+        }
+        CHECK_STATUS(sc_batch_read_pairs(pairs, &record), SC_STATUS_OK);
+        CHECK(strstr(sc_batch_record_json(record), "\"a\":\"left arm\"") != NULL, "%s",
+              sc_batch_record_json(record));
+        sc_batch_record_free(record);
+        CHECK_STATUS(sc_batch_read_pairs(missing, &record), SC_STATUS_FILE_ERROR);
+        CHECK_STATUS(sc_batch_read_pairs(NULL, &record), SC_STATUS_NULL_ARGUMENT);
+    }
     CHECK(sc_batch_record_json(NULL) == NULL && !sc_batch_record_ok(NULL), "NULL record");
     sc_batch_record_free(NULL);
     sc_batch_free(NULL);

@@ -4,6 +4,7 @@
 //! once per file. Tests that need a process of their own start one (limits.rs runs itself
 //! again with one global thread). Shapes made by the tests themselves are in common.rs.
 
+mod collection;
 mod common;
 mod correspondence;
 mod determinism;

@@ -233,6 +233,9 @@ FUNCTIONS = {
     "sc_batch_record_json": (ctypes.c_char_p, [handle]),
     "sc_batch_record_ok": (ctypes.c_bool, [handle]),
     "sc_batch_record_free": (None, [handle]),
+    "sc_batch_open_folder": (status, [handle, c_str, handle_out]),
+    "sc_batch_folder_free": (None, [handle]),
+    "sc_batch_read_pairs": (status, [c_str, handle_out]),
 }
 
 def _raising_the_original(function):

@@ -41,7 +41,7 @@ if sys.version_info >= (3, 11):
 elif TYPE_CHECKING:  # annotations only (PEP 563)
     from typing_extensions import Unpack
 
-__all__ = ["match_pairs", "summary", "matrix", "write_matrix", "consistent_labels", "read_map"]
+__all__ = ["match_pairs", "summary", "matrix", "write_matrix", "consistent_labels", "read_map", "read_pairs"]
 
 SHAPE_SUFFIXES = (".ply", ".off", ".obj")
 
@@ -86,12 +86,14 @@ class _Batch:
         return self._pointer
 
     def _record(self, function, *args):
-        record = ctypes.c_void_p()
-        _check(function(self, *args, ctypes.byref(record)))
-        try:
-            return json.loads(lib.sc_batch_record_json(record).decode("utf-8"))
-        finally:
-            lib.sc_batch_record_free(record)
+        return _record(function, self, *args)
+
+    def open_folder(self, out):
+        """Locks the output folder and checks (or records) the settings in ``batch.json``,
+        as the command line does (``sc_batch_open_folder``); :class:`_Folder` releases it."""
+        pointer = ctypes.c_void_p()
+        _check(lib.sc_batch_open_folder(self, os.fsencode(out), ctypes.byref(pointer)))
+        return _Folder(pointer)
 
     def prepare(self, name, path):
         return self._record(lib.sc_batch_prepare, name.encode(), os.fsencode(path))
@@ -106,6 +108,35 @@ class _Batch:
             os.fsencode(path_b),
             os.fsencode(out),
         )
+
+
+def _record(function, *args):
+    """Calls a C function that gives an ``sc_batch_record``; returns its JSON, decoded."""
+    record = ctypes.c_void_p()
+    _check(function(*args, ctypes.byref(record)))
+    try:
+        return json.loads(lib.sc_batch_record_json(record).decode("utf-8"))
+    finally:
+        lib.sc_batch_record_free(record)
+
+
+class _Folder:
+    """A locked output folder; ``close()`` releases the lock (so does the process's end)."""
+
+    def __init__(self, pointer):
+        self._pointer = pointer
+
+    def close(self):
+        if self._pointer:
+            lib.sc_batch_folder_free(self._pointer)
+            self._pointer = None
+
+
+def read_pairs(path: FilePath) -> list[tuple[str, str]]:
+    """The ``(A, B)`` name pairs of a pair file, read by the library as ``shapecorr batch
+    --pairs FILE`` reads it: ``A<TAB>B[<TAB>CATEGORY]`` per line (names may hold spaces), a
+    line without a tab split at spaces, ``#`` comments (docs/collections.md)."""
+    return [(p["a"], p["b"]) for p in _record(lib.sc_batch_read_pairs, os.fsencode(path))]
 
 
 #: glibc's mallopt parameters (malloc.h).
@@ -206,15 +237,7 @@ def _pairs(spec, inputs):
         t = _find(inputs, spec[len("one-to-many:"):])
         return [(t, j) for j in range(n) if j != t]
     if isinstance(spec, (str, os.PathLike)):
-        pairs = []
-        for line in Path(spec).read_text().splitlines():
-            line = line.strip()
-            if line and not line.startswith("#"):
-                fields = line.split()
-                if len(fields) < 2:
-                    raise ValueError(f"{spec}: expected `source<TAB>target[<TAB>category]`, got {line!r}")
-                pairs.append((fields[0], fields[1]))
-        spec = pairs
+        spec = read_pairs(spec)
     return [(_find(inputs, a), _find(inputs, b)) for a, b in spec]
 
 
@@ -267,17 +290,20 @@ def match_pairs(
     returns the log's path.
 
     ``shapes``: files and folders, or a dict of name -> file. ``pairs``: ``"all"``,
-    ``"one-to-many:NAME"``, a pair file (``A B [category]`` per line) or a list of name
-    pairs. ``client``: a ``dask.distributed.Client`` (None: threads here, ``workers`` of
+    ``"one-to-many:NAME"``, a pair file (``A<TAB>B[<TAB>CATEGORY]`` per line, read as
+    :func:`read_pairs` does) or a list of name pairs. ``client``: a ``dask.distributed.Client`` (None: threads here, ``workers`` of
     them, one per core by default). ``cache``: the eigenbasis cache folder (default
     ``out/cache``; every worker must see it). ``options``: the library's named options.
     ``progress(done, total, record)`` is called as each pair finishes. A failed pair is a
     record with ``ok`` false and the library's message; it never stops the batch (and is
-    not retried on resume unless ``retry_failed``)."""
+    not retried on resume unless ``retry_failed``). The folder is locked while the batch
+    runs (a second batch on it raises) and holds the settings in ``batch.json``: a folder
+    of a batch with other settings, by this package or by ``shapecorr batch``, is refused.
+    A shape whose eigenbasis could not be cached, or whose cache entry was damaged, gets a
+    ``warning`` in ``shapes.jsonl`` and is computed without the cache."""
     inputs = _inputs(shapes)
     todo_all = _pairs(pairs, inputs)
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     settings = {
         "maps": bool(maps),
         "points": bool(points),
@@ -285,8 +311,16 @@ def match_pairs(
         "cache": str(Path(cache) if cache is not None else out / "cache"),
         "options": _choice_values(options),  # choices by value, whichever way given
     }
-    _check_same_settings(out, settings)
-    _Batch.of(settings)  # bad options fail here, before any task is sent
+    # Bad options fail here, before any task is sent; then the folder is locked and its
+    # settings checked by the library, as the command line does.
+    folder = _Batch.of(settings).open_folder(out)
+    try:
+        return _run(inputs, todo_all, out, settings, client, workers, retry_failed, progress)
+    finally:
+        folder.close()
+
+
+def _run(inputs, todo_all, out, settings, client, workers, retry_failed, progress):
     log = _Log(out / "pairs.jsonl")
     done = {(r["a"], r["b"]) for r in log.records if r.get("ok") or not retry_failed}
     todo = [(i, j) for i, j in todo_all if (inputs[i][0], inputs[j][0]) not in done]
@@ -347,18 +381,6 @@ def _finish(log, record, progress, finished, total):
     log.append(record)
     if progress is not None:
         progress(finished, total, record)
-
-
-def _check_same_settings(out, settings):
-    path = out / "batch-python.json"
-    if path.exists():
-        if json.loads(path.read_text()) != json.loads(json.dumps(settings)):
-            raise ValueError(
-                f"{out} holds a batch run with other settings or options; use another `out` "
-                "(or delete the folder to start over)"
-            )
-    else:
-        path.write_text(json.dumps(settings, indent=1))
 
 
 def _records(out):

@@ -164,3 +164,43 @@ def test_a_killed_dask_worker_loses_and_duplicates_no_pair(local_run, figures, c
     assert killed.is_set()
     assert victim not in client.run(os.getpid).values()
     assert by_pair(out) == by_pair(local_run)
+
+
+def test_pair_files_are_read_by_the_library_and_names_get_maps_of_their_own(figures, tmp_path):
+    pair_file = tmp_path / "pairs.txt"
+    pair_file.write_text("# a\tb\nx--y\tz\tcategory\nx\ty--z left\n")
+    assert batch.read_pairs(pair_file) == [("x--y", "z"), ("x", "y--z left")]
+    shapes = {"x--y": figures / "h0.off", "z": figures / "h1.off", "x": figures / "h2.off",
+              "y--z left": figures / "h3.off"}
+    out = tmp_path / "out"
+    batch.match_pairs(shapes, out, pairs=pair_file, maps=True, workers=2)
+    results = by_pair(out)
+    assert {results[p]["map"] for p in [("x--y", "z"), ("x", "y--z left")]} == {
+        "maps/x%2D%2Dy--z.u32", "maps/x--y%2D%2Dz left.u32"}
+    assert len(list((out / "maps").iterdir())) == 2
+    for a, b in results:
+        assert len(batch.read_map(out, a, b)) == len(results[(a, b)]["regions_b"])
+    pair_file.write_text("x\tz\nlonely\n")
+    with pytest.raises(shapecorr.ShapecorrError, match="line 2"):
+        batch.read_pairs(pair_file)
+
+
+def test_a_held_folder_or_other_settings_are_refused(figures, tmp_path):
+    shapes = {"h0": figures / "h0.off", "h1": figures / "h1.off"}
+    out = tmp_path / "out"
+    refused = []
+
+    def second_run(done, total, record):
+        try:
+            batch.match_pairs(shapes, out, workers=1, k_max=6)
+        except shapecorr.ShapecorrError as error:
+            refused.append(str(error))
+
+    batch.match_pairs(shapes, out, workers=1, k_max=6, progress=second_run)
+    assert len(refused) == 1 and "another batch is running" in refused[0], refused
+    assert len(records(out)) == 1
+    batch.match_pairs(shapes, out, workers=1, k_max=6)  # released: resumes
+    with pytest.raises(shapecorr.ShapecorrError, match="other settings"):
+        batch.match_pairs(shapes, out, workers=1)
+    settings = json.loads((out / "batch.json").read_text())
+    assert settings["options"]["k_max"] == 6 and "cache" not in settings

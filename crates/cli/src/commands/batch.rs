@@ -8,16 +8,15 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use serde_json::json;
 use shapecorr::collection::{
-    Batch, BatchSettings, Outputs, PairRecord, Prepared, Reading, ResultLog, ShapeRecord,
-    DEFAULT_MEMORY_BYTES,
+    read_pairs, Batch, BatchSettings, OutputFolder, Outputs, PairRecord, Prepared, Reading,
+    ResultLog, ShapeRecord, DEFAULT_MEMORY_BYTES,
 };
 use shapecorr::Error;
 use shapecorr_eval::bench_store::ProgressBar;
 
 use crate::options::PointwiseOptions;
-use crate::output::{create_dir, options_json, write_json, QUIET};
+use crate::output::QUIET;
 
 /// Shape files a folder contributes.
 const SHAPE_EXTENSIONS: [&str; 3] = ["ply", "off", "obj"];
@@ -28,29 +27,31 @@ pub struct BatchArgs {
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     /// Output folder: pairs.jsonl (a line per pair), shapes.jsonl (a line per shape
-    /// prepared), maps/ (with --maps), batch.json (the settings) and cache/ (eigenbases,
-    /// unless --cache). Running again with the same folder resumes: finished pairs are
-    /// skipped.
+    /// prepared), maps/ (with --maps), batch.json (the settings), batch.lock (held while a
+    /// run uses the folder) and cache/ (eigenbases, unless --cache). Running again with the
+    /// same folder and settings resumes: finished pairs are skipped.
     #[arg(long)]
     out: PathBuf,
     /// Which pairs: `all` (every unordered pair once, A before B in input order),
     /// `one-to-many:NAME` (the template NAME as A against every other shape: consistent
-    /// labels), or a pair file (`A B [category]` per line, tab or space separated, `#`
-    /// comments; names as in shapes.jsonl or file stems).
+    /// labels), or a pair file (`A<TAB>B[<TAB>CATEGORY]` per line, names may hold spaces; a
+    /// line without a tab is split at spaces; `#` comments; names as in shapes.jsonl or file
+    /// stems).
     #[arg(long, default_value = "all")]
     pairs: String,
     /// Region correspondences (the default; as `shapecorr match`).
     #[arg(long)]
     regions: bool,
     /// Point-to-point maps too (as `shapecorr p2p`; its regions come with it), each written
-    /// to maps/A--B.u32: a vertex of A for every vertex of B, little-endian u32.
+    /// to maps/A--B.u32 (names escaped, docs/collections.md): a vertex of A for every
+    /// vertex of B, little-endian u32.
     #[arg(long)]
     maps: bool,
     /// Eigenbasis cache folder (default OUT/cache); several runs and processes may share it.
     #[arg(long)]
     cache: Option<PathBuf>,
     /// Pairs computed at once (0: one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true, value_parser = parse_jobs)]
     jobs: usize,
     /// Compute again the pairs a previous run recorded as failed.
     #[arg(long)]
@@ -81,15 +82,7 @@ impl BatchArgs {
         };
         let inputs = self.inputs()?;
         let pairs = self.pairs(&inputs)?;
-        create_dir(&self.out)?;
-        let settings = json!({
-            "outputs": if self.maps { "regions+maps" } else { "regions" },
-            "points": self.points,
-            "repair": !self.no_repair,
-            "options": options_json(&options, self.maps),
-        });
-        self.check_same_settings(&settings)?;
-        let batch = Batch::new(BatchSettings {
+        let settings = BatchSettings {
             options,
             reading: Reading {
                 points: self.points,
@@ -99,14 +92,33 @@ impl BatchArgs {
             outputs,
             cache_dir: self.cache.clone().unwrap_or_else(|| self.out.join("cache")),
             memory_bytes: DEFAULT_MEMORY_BYTES,
-        })?;
+        };
+        // Held until the run ends: a second run on this folder is refused.
+        let _folder = OutputFolder::open(&self.out, &settings)?;
+        let batch = Batch::new(settings)?;
 
         let (mut log, done) = ResultLog::open::<PairRecord>(&self.out.join("pairs.jsonl"))?;
-        let finished: BTreeSet<(String, String)> = done
+        let wanted: BTreeSet<(&str, &str)> = pairs
             .iter()
-            .filter(|r| r.ok || !self.retry_failed)
-            .map(|r| (r.a.clone(), r.b.clone()))
+            .map(|&(i, j)| (inputs[i].name.as_str(), inputs[j].name.as_str()))
             .collect();
+        // The latest record of each pair of this run (a pair retried later has two).
+        let mut earlier: BTreeMap<(String, String), bool> = BTreeMap::new();
+        for r in done
+            .iter()
+            .filter(|r| wanted.contains(&(r.a.as_str(), r.b.as_str())))
+        {
+            earlier.insert((r.a.clone(), r.b.clone()), r.ok);
+        }
+        let finished: BTreeSet<(String, String)> = earlier
+            .iter()
+            .filter(|(_, &ok)| ok || !self.retry_failed)
+            .map(|(pair, _)| pair.clone())
+            .collect();
+        let failed_before = earlier
+            .iter()
+            .filter(|(pair, &ok)| !ok && finished.contains(pair))
+            .count();
         let todo: Vec<(usize, usize)> = pairs
             .into_iter()
             .filter(|&(i, j)| !finished.contains(&(inputs[i].name.clone(), inputs[j].name.clone())))
@@ -136,6 +148,9 @@ impl BatchArgs {
         });
         let (mut computed, mut unusable) = (0, 0);
         for (i, shape, record) in records {
+            if let Some(warning) = &record.warning {
+                eprintln!("shapecorr: warning: shape {}: {warning}", record.name);
+            }
             computed += usize::from(record.computed);
             unusable += usize::from(!record.ok);
             shape_log.append(&record)?;
@@ -168,9 +183,9 @@ impl BatchArgs {
             return Err(e);
         }
         println!(
-            "{} pairs ({} now, {} from an earlier run), {failed} failed now; {} shapes \
-             ({computed} eigenbases computed, {} from the cache, {unusable} unusable) in {:.1} s; \
-             pairs {:.1} s; total {:.1} s -> {}",
+            "{} pairs ({} now, {} from an earlier run), {failed} failed now, {failed_before} \
+             failed in an earlier run; {} shapes ({computed} eigenbases computed, {} from the \
+             cache, {unusable} unusable) in {:.1} s; pairs {:.1} s; total {:.1} s -> {}",
             total,
             todo.len(),
             finished.len(),
@@ -181,6 +196,16 @@ impl BatchArgs {
             started.elapsed().as_secs_f64(),
             self.out.join("pairs.jsonl").display()
         );
+        if failed + failed_before > 0 {
+            return Err(Error::file(
+                self.out.join("pairs.jsonl"),
+                format!(
+                    "{} of {total} pairs failed ({failed} now, {failed_before} in an earlier \
+                     run); their lines say why, and --retry-failed computes them again",
+                    failed + failed_before
+                ),
+            ));
+        }
         Ok(())
     }
 
@@ -266,37 +291,17 @@ impl BatchArgs {
                 ),
             });
         }
-        shapecorr_eval::datasets::read_pairs(file)?
+        read_pairs(file)?
             .iter()
-            .enumerate()
-            .map(|(number, pair)| {
+            .map(|pair| {
                 let at = |name: &str| {
                     find(inputs, name).map_err(|reason| {
-                        Error::file(file, format!("pair {}: {reason}", number + 1))
+                        Error::file(file, format!("line {}: {reason}", pair.line))
                     })
                 };
-                Ok((at(&pair.source)?, at(&pair.target)?))
+                Ok((at(&pair.a)?, at(&pair.b)?))
             })
             .collect()
-    }
-
-    /// Refuses to resume a folder written with other settings (its pairs would mix two
-    /// answers); records the settings on a first run.
-    fn check_same_settings(&self, settings: &serde_json::Value) -> Result<(), Error> {
-        let path = self.out.join("batch.json");
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            let earlier: serde_json::Value =
-                serde_json::from_str(&text).map_err(|e| Error::file(&path, e.to_string()))?;
-            if &earlier != settings {
-                return Err(Error::file(
-                    &path,
-                    "this folder holds a batch run with other settings or options; use \
-                     another --out (or delete the folder to start over)",
-                ));
-            }
-            return Ok(());
-        }
-        write_json(&path, settings)
     }
 
     fn bar(&self, label: &str, total: usize, already: usize) -> Option<ProgressBar> {
@@ -337,6 +342,17 @@ fn parallel<T: Sync, R: Send>(items: &[T], jobs: usize, work: impl Fn(&T) -> R +
         }
     });
     results.into_inner().unwrap_or_else(|e| e.into_inner())
+}
+
+/// `--jobs`: 0 or a positive count (a negative one is refused with this message rather than
+/// taken for an option).
+fn parse_jobs(text: &str) -> Result<usize, String> {
+    let value: i64 = text.trim().parse().map_err(|_| {
+        format!("expected a whole number of pairs at once (0: one per core), got {text:?}")
+    })?;
+    usize::try_from(value).map_err(|_| {
+        format!("expected 0 (one per core) or a positive number of pairs at once, got {value}")
+    })
 }
 
 fn has_shape_extension(path: &Path) -> bool {

@@ -200,20 +200,33 @@ fn bad_entries_are_failed_pairs_and_maps_are_those_of_p2p() {
     )
     .unwrap();
     let out = dir.join("out");
-    let summary = ok(shapecorr(&[
-        "batch",
-        s(&shapes),
-        "--pairs",
-        s(&pair_file),
-        "--maps",
-        "--out",
-        s(&out),
-        "--quiet",
-    ]));
-    assert!(
-        summary.contains("4 pairs (4 now, 0 from an earlier run), 2 failed now"),
-        "{summary}"
-    );
+    let run = || {
+        shapecorr(&[
+            "batch",
+            s(&shapes),
+            "--pairs",
+            s(&pair_file),
+            "--maps",
+            "--out",
+            s(&out),
+            "--quiet",
+        ])
+    };
+    // Failed pairs make the exit status non-zero, now and in a resumed run that skips them.
+    for (i, summary) in [
+        "4 pairs (4 now, 0 from an earlier run), 2 failed now, 0 failed in an earlier run",
+        "4 pairs (0 now, 4 from an earlier run), 0 failed now, 2 failed in an earlier run",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let output = run();
+        assert!(!output.status.success(), "run {i}");
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(stdout.contains(summary), "{stdout}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains("2 of 4 pairs failed"), "{stderr}");
+    }
     let pairs = lines(&out.join("pairs.jsonl"));
     let shape_lines = lines(&out.join("shapes.jsonl"));
     let reason = |name: &str| {
@@ -293,4 +306,235 @@ fn bad_entries_are_failed_pairs_and_maps_are_those_of_p2p() {
         "{}",
         String::from_utf8_lossy(&out2.stderr)
     );
+}
+
+/// A copy of `figures` under new names.
+fn named(dir: &Path, figures: &[PathBuf], names: &[&str]) -> Vec<PathBuf> {
+    std::fs::create_dir_all(dir).unwrap();
+    figures
+        .iter()
+        .zip(names)
+        .map(|(from, name)| {
+            let to = dir.join(format!("{name}.ply"));
+            std::fs::copy(from, &to).unwrap();
+            to
+        })
+        .collect()
+}
+
+fn pair_answers(out: &Path) -> Vec<(String, String, Value, Value)> {
+    let mut answers: Vec<_> = lines(&out.join("pairs.jsonl"))
+        .into_iter()
+        .map(|r| {
+            assert_eq!(r["ok"], true, "{r}");
+            (
+                r["a"].as_str().unwrap().to_string(),
+                r["b"].as_str().unwrap().to_string(),
+                r["regions_b"].clone(),
+                r["matches_one_to_one"].clone(),
+            )
+        })
+        .collect();
+    answers.sort_by(|x, y| (&x.0, &x.1).cmp(&(&y.0, &y.1)));
+    answers
+}
+
+fn files_named(dir: &Path, part: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            found.extend(files_named(&path, part));
+        } else if path.to_string_lossy().contains(part) {
+            found.push(path.display().to_string());
+        }
+    }
+    found
+}
+
+#[test]
+fn damaged_foreign_or_unstorable_cache_entries_give_the_answers_of_a_fresh_run() {
+    let dir = scratch("cache");
+    let shapes = dir.join("shapes");
+    std::fs::create_dir_all(&shapes).unwrap();
+    figures(&shapes, 3);
+    let batch = |out: &Path, cache: &Path| {
+        shapecorr(&[
+            "batch",
+            s(&shapes),
+            "--out",
+            s(out),
+            "--cache",
+            s(cache),
+            "--quiet",
+        ])
+    };
+    let reference = dir.join("ref");
+    ok(batch(&reference, &dir.join("cache0")));
+    let expected = pair_answers(&reference);
+    let keys: Vec<String> = lines(&reference.join("shapes.jsonl"))
+        .iter()
+        .map(|r| r["key"].as_str().unwrap().to_string())
+        .collect();
+    let entry = |cache: &Path, i: usize| cache.join(format!("{}.basis", keys[i]));
+
+    // fig0's entry with flipped exponent bits, fig1's holding fig2's valid entry.
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    for i in 0..3 {
+        std::fs::copy(entry(&dir.join("cache0"), i), entry(&bad, i)).unwrap();
+    }
+    let mut bytes = std::fs::read(entry(&bad, 0)).unwrap();
+    for i in 0..200 {
+        let at = 32 + 8 * (1000 + i * 700) + 7;
+        if at < bytes.len() {
+            bytes[at] ^= 0x10;
+        }
+    }
+    std::fs::write(entry(&bad, 0), bytes).unwrap();
+    std::fs::copy(entry(&bad, 2), entry(&bad, 1)).unwrap();
+    let out = dir.join("out_bad");
+    let output = batch(&out, &bad);
+    let stdout = ok(output.clone());
+    assert!(
+        stdout.contains("2 eigenbases computed, 1 from the cache"),
+        "{stdout}"
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("fig0: cache entry") && stderr.contains("fig1: cache entry"),
+        "{stderr}"
+    );
+    assert_eq!(pair_answers(&out), expected);
+    let warned = lines(&out.join("shapes.jsonl"))
+        .iter()
+        .filter(|r| {
+            r["warning"]
+                .as_str()
+                .is_some_and(|w| w.contains("computed again"))
+        })
+        .count();
+    assert_eq!(warned, 2);
+    // Replaced: the next run takes all three from the cache.
+    let again = ok(batch(&dir.join("out_again"), &bad));
+    assert!(
+        again.contains("0 eigenbases computed, 3 from the cache"),
+        "{again}"
+    );
+
+    // A cache where nothing can be stored (a folder in each entry's place; chmod would not
+    // stop root): every pair computed, a warning per shape, no temporary file left.
+    let stuck = dir.join("stuck");
+    for i in 0..3 {
+        std::fs::create_dir_all(entry(&stuck, i)).unwrap();
+    }
+    let out = dir.join("out_stuck");
+    let output = batch(&out, &stuck);
+    let stdout = ok(output.clone());
+    assert!(
+        stdout.contains("0 failed now, 0 failed in an earlier run"),
+        "{stdout}"
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(
+        stderr.matches("could not be stored in the cache").count(),
+        3,
+        "{stderr}"
+    );
+    assert_eq!(pair_answers(&out), expected);
+    assert_eq!(files_named(&dir, ".tmp"), Vec::<String>::new());
+}
+
+#[test]
+fn names_with_separators_or_spaces_get_maps_of_their_own() {
+    let dir = scratch("names");
+    std::fs::create_dir_all(dir.join("made")).unwrap();
+    let made = figures(&dir.join("made"), 4);
+    let shapes = dir.join("shapes");
+    named(&shapes, &made, &["x--y", "z", "x", "y--z left"]);
+    let pair_file = dir.join("pairs.txt");
+    std::fs::write(&pair_file, "x--y\tz\nx\ty--z left\tspaced\n").unwrap();
+    let out = dir.join("out");
+    ok(shapecorr(&[
+        "batch",
+        s(&shapes),
+        "--pairs",
+        s(&pair_file),
+        "--maps",
+        "--out",
+        s(&out),
+        "--quiet",
+    ]));
+    let records = lines(&out.join("pairs.jsonl"));
+    assert_eq!(records.len(), 2);
+    let maps: BTreeSet<&str> = records.iter().map(|r| r["map"].as_str().unwrap()).collect();
+    assert_eq!(maps.len(), 2, "{maps:?}");
+    for r in &records {
+        let map = shapecorr::collection::read_map(&out.join(r["map"].as_str().unwrap())).unwrap();
+        assert_eq!(map.len(), r["regions_b"].as_array().unwrap().len(), "{r}");
+    }
+    assert_eq!(std::fs::read_dir(out.join("maps")).unwrap().count(), 2);
+
+    // A line that is not a pair names its line.
+    std::fs::write(&pair_file, "x\tz\nlonely\n").unwrap();
+    let output = shapecorr(&[
+        "batch",
+        s(&shapes),
+        "--pairs",
+        s(&pair_file),
+        "--out",
+        s(&out),
+    ]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("line 2: expected `A<TAB>B`"), "{stderr}");
+}
+
+#[test]
+fn a_held_folder_or_other_settings_are_refused_and_a_negative_jobs_is_explained() {
+    let dir = scratch("held");
+    let shapes = dir.join("shapes");
+    std::fs::create_dir_all(&shapes).unwrap();
+    figures(&shapes, 2);
+    let out = dir.join("out");
+    // What the Python package does through the C API: the library opens the folder with
+    // its settings (k_max 6 here) and holds it while its batch runs.
+    let mut options = shapecorr::options::Options::default();
+    options
+        .set_option("k_max", shapecorr::options::OptionValue::Int(6))
+        .unwrap();
+    let settings = shapecorr::collection::BatchSettings {
+        options,
+        reading: Default::default(),
+        outputs: shapecorr::collection::Outputs::Regions,
+        cache_dir: dir.join("cache"),
+        memory_bytes: shapecorr::collection::DEFAULT_MEMORY_BYTES,
+    };
+    let held = shapecorr::collection::OutputFolder::open(&out, &settings).unwrap();
+    let batch = |more: &[&str]| {
+        let mut args = vec!["batch", s(&shapes), "--out", s(&out), "--quiet"];
+        args.extend_from_slice(more);
+        shapecorr(&args)
+    };
+    let output = batch(&["--k-max", "6"]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("another batch is running"), "{stderr}");
+    assert!(!out.join("pairs.jsonl").exists());
+    drop(held);
+    let output = batch(&[]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("other settings or options"), "{stderr}");
+    ok(batch(&["--k-max", "6"]));
+
+    for jobs in ["-1", "two"] {
+        let output = batch(&["--k-max", "6", "--jobs", jobs]);
+        assert!(!output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("pairs at once") && !stderr.contains("unexpected argument"),
+            "{stderr}"
+        );
+    }
 }
