@@ -143,7 +143,9 @@ fn cache_info() -> Option<[CacheInfo; 3]> {
 					for info in &mut all_info {
 						info.cache_bytes *= l1_shared_count;
 					}
-					all_info[2].cache_bytes *= num_cpus::get_physical();
+					// shapecorr: the L3 share of one core, not of the whole machine (upstream multiplies by
+					// the physical cores here; every thread's scratch is 2 x this, so a 100-core machine
+					// reserved about 1 GB of address space per thread).
 
 					Ok(all_info)
 				}

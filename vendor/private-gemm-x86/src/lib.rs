@@ -1283,18 +1283,11 @@ pub unsafe fn gemm(
 	let lhs_size = (l3.next_multiple_of(16) * sizeof).div_ceil(size_of::<Page>());
 	let rhs_size = (l3.next_multiple_of(nr) * sizeof).div_ceil(size_of::<Page>());
 
+	// shapecorr: the scratch grows when a call needs it, and a failed reservation panics (which the
+	// caller can catch) instead of aborting the process (upstream reserves 2 x L3 at the first
+	// call of each thread with `Vec::with_capacity`).
 	thread_local! {
-		static MEM: RefCell<Vec::<core::mem::MaybeUninit<Page>>> = {
-			let cache = *cache::CACHE_INFO;
-			let l3 = cache[2].cache_bytes;
-
-			let lhs_size = l3.div_ceil(size_of::<Page>());
-			let rhs_size = l3.div_ceil(size_of::<Page>());
-
-			let mut mem = Vec::with_capacity(lhs_size + rhs_size);
-			unsafe { mem.set_len(lhs_size + rhs_size) };
-			RefCell::new(mem)
-		};
+		static MEM: RefCell<Vec::<core::mem::MaybeUninit<Page>>> = const { RefCell::new(Vec::new()) };
 	}
 
 	MEM.with(|mem| {
@@ -1307,13 +1300,19 @@ pub unsafe fn gemm(
 				&mut *storage
 			},
 			Err(_) => {
-				alloc = Vec::with_capacity(lhs_size + rhs_size);
+				alloc = Vec::new();
 
 				&mut alloc
 			},
 		};
 		if mem.len() < lhs_size + rhs_size {
-			mem.reserve_exact(lhs_size + rhs_size);
+			let additional = lhs_size + rhs_size - mem.len();
+			if mem.try_reserve_exact(additional).is_err() {
+				panic!(
+					"matrix product scratch: {} bytes could not be allocated",
+					(lhs_size + rhs_size) * size_of::<Page>()
+				);
+			}
 			unsafe { mem.set_len(lhs_size + rhs_size) };
 		}
 
