@@ -97,7 +97,8 @@ pub enum Error {
     #[error("resource limit `{limit}`: {reason}")]
     ResourceLimit {
         /// The limit: the option that sets it (`memory_limit_mib`, `time_limit_s`,
-        /// `max_vertices`), or `available_memory` for the memory the system can give.
+        /// `max_vertices`), `available_memory` for the memory the system can give, or
+        /// `address_space` for the process's address-space limit (`ulimit -v`).
         limit: &'static str,
         /// What the job needs (the estimate) or did, against the limit, and what to do.
         reason: String,
@@ -105,7 +106,7 @@ pub enum Error {
 }
 
 /// The limits of a whole job rather than of one shape ([`Error::in_shape`]).
-const JOB_LIMITS: [&str; 2] = ["memory_limit_mib", "time_limit_s"];
+const JOB_LIMITS: [&str; 3] = ["memory_limit_mib", "time_limit_s", "address_space"];
 
 /// Result with the crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;

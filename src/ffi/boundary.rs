@@ -185,6 +185,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 /// Runs an exported function's body: a failure sets the last error and returns its status,
 /// a panic is caught and becomes [`ScStatus::Panic`].
 pub(crate) fn boundary(body: impl FnOnce() -> FfiResult) -> ScStatus {
+    crate::system::fit_allocator_to_address_space_limit();
     match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(())) => ScStatus::Ok,
         Ok(Err(failure)) => {

@@ -112,6 +112,14 @@ const CONVERSION_PRODUCTS_PER_SECOND: f64 = 8e9;
 /// Lanczos): 0.9 s for 20K vertices and 50 eigenpairs, 6-15 s for 50K and 50-100.
 const EIGEN_SECONDS: f64 = 1e-7;
 
+/// Address space a thread takes beyond the estimate, counted under an address-space limit:
+/// the matrix products' scratch (2 x one core's L3 share: 32 MiB on the 2-core reference
+/// machine) and its stack (2 MiB). With one allocator arena
+/// ([`crate::system::fit_allocator_to_address_space_limit`]) a 5K-vertex `match` there
+/// peaked at 162 MiB of address space against an estimate of 180 MiB (docs/decisions.md,
+/// "Address space").
+const ADDRESS_SPACE_PER_THREAD: u64 = 40 << 20;
+
 /// The job's estimated peak memory and time.
 pub fn estimate(job: &Job) -> Estimate {
     let [n_a, n_b] = job.vertices.map(|n| n as u64);
@@ -188,6 +196,25 @@ impl Budget {
                             "memory available,"
                         },
                         limit as f64 / MIB
+                    ),
+                });
+            }
+        }
+        if let Some(left) = crate::system::address_space_left() {
+            let threads = job.threads as u64 + 2;
+            let needs = estimate.bytes + threads * ADDRESS_SPACE_PER_THREAD;
+            if needs > left {
+                return Err(Error::ResourceLimit {
+                    limit: "address_space",
+                    reason: format!(
+                        "the job on {pair} needs about {:.0} MiB of address space ({:.0} MiB \
+                         and {threads} threads), more than the {:.0} MiB the process may \
+                         still map under its address-space limit (ulimit -v); raise the \
+                         limit, use fewer threads, simplify the shapes or ask for fewer \
+                         eigenpairs",
+                        needs as f64 / MIB,
+                        estimate.mib(),
+                        left as f64 / MIB
                     ),
                 });
             }

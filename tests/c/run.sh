@@ -90,4 +90,12 @@ awk '/<!-- readme-c-example -->/{m=1; next} m && /^```c/{p=1; next} p && /^```/{
 "$cc" -std=c99 "${warn[@]}" -Iinclude "$out/readme_example.c" "${link[@]}" -o "$out/readme_example"
 (cd "$out" && ./readme_example a.ply b.ply) | tee "$out/readme_example.txt"
 [ -s "$out/readme_example.txt" ]
+echo "== under an address-space limit (ulimit -v): 5K-vertex figures run under 1 GB, and"
+echo "   under 300 MB return SC_STATUS_RESOURCE_LIMIT, never abort (plain build: ASan and"
+echo "   valgrind reserve more address space than these limits)"
+"$lib_dir/shapecorr" synth --kind humanoid --pose 0 --vertices 5000 --out "$out/a5.ply" >/dev/null
+"$lib_dir/shapecorr" synth --kind humanoid --pose 3 --vertices 5000 --out "$out/b5.ply" >/dev/null
+"$cc" -std=c99 "${warn[@]}" -O1 -g -Iinclude tests/c/memory_cap.c "${link[@]}" -o "$out/memory_cap"
+(ulimit -v 1048576 && RAYON_NUM_THREADS=2 "$out/memory_cap" "$out/a5.ply" "$out/b5.ply" ok)
+(ulimit -v 307200 && RAYON_NUM_THREADS=2 "$out/memory_cap" "$out/a5.ply" "$out/b5.ply" limit)
 echo "C tests passed"

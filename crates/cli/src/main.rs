@@ -91,6 +91,8 @@ fn main() -> ExitCode {
     quit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     output::QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
+    // Before any thread: under `ulimit -v`, one allocator arena instead of one per thread.
+    shapecorr::system::fit_allocator_to_address_space_limit();
     // The whole command runs on a worker of one rayon pool: parallel loops called from
     // inside it start without handing work over from a foreign thread, which with many
     // small loops (k-means, Lanczos) cost measurable time in thread wake-ups. Threads come

@@ -7,3 +7,4 @@ mod bench_all;
 mod cli;
 mod common;
 mod hostile;
+mod memory_cap;
