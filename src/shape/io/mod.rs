@@ -142,7 +142,7 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 /// The bytes of a regular file of at most [`MAX_FILE_BYTES`]. FIFOs, devices (`/dev/zero`,
 /// also through a symbolic link), sockets and directories are refused before the file is
 /// opened, so reading never blocks or runs unbounded.
-fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
     use std::io::Read;
     let cannot = |e: std::io::Error| Error::file(path, format!("cannot read the file: {e}"));
     let meta = std::fs::metadata(path).map_err(cannot)?;

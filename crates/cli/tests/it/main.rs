@@ -6,4 +6,5 @@ mod batch;
 mod bench_all;
 mod cli;
 mod common;
+mod files;
 mod hostile;
