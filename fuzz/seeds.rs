@@ -3,7 +3,8 @@
 //! library's PLY writer and with the small OFF/OBJ/XYZ writers below), a tetrahedron, a cube
 //! of quads, a grid, its triangle soup, a sampled point cloud, and the edge cases the readers
 //! accept (comments, CRLF, polygons, negative OBJ indices, colours and normals, other
-//! elements, both byte orders, every PLY type).
+//! elements, both byte orders, every PLY type), and values files (`read_values`: blanks,
+//! commas, comments, wide integers, and the refused empty field and non-ASCII separator).
 
 use std::fmt::Write as _;
 use std::path::Path;

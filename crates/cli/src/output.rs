@@ -193,12 +193,15 @@ pub fn check_output_file(path: &Path) -> Result<(), Error> {
 /// Writes every file of `files` whole, or none of them where it can: each is first written
 /// to a temporary file in its destination's folder, and the temporary files replace the
 /// destinations only when all are written. An existing destination that is not a regular
-/// file (`/dev/null`, a FIFO) is written in place; a symbolic link is followed.
+/// file (`/dev/null`, a FIFO) is written in place, before the others are renamed; a
+/// symbolic link is followed.
 pub fn write_files(files: &[(&Path, &[u8])]) -> Result<(), Error> {
     let mut staged = Vec::with_capacity(files.len());
     for &(path, bytes) in files {
         staged.push(Staged::write(path, bytes)?);
     }
+    // Files written in place first: they are the ones whose writing can still fail.
+    staged.sort_by_key(|file| matches!(file, Staged::Temporary(..)));
     for file in staged {
         file.commit()?;
     }

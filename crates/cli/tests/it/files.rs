@@ -209,6 +209,11 @@ fn a_failed_transfer_leaves_an_existing_output_as_it_was() {
     let run = transfer(&a, &b, &values, &out, &[]);
     assert_clean_failure(&run, &["rows of values"]);
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "earlier result\n");
+    // The job runs, the second output cannot be written: the first is not replaced either.
+    let values = values_file(&dir.join("v.txt"), "1 2", n);
+    let run = transfer(&a, &b, &values, &out, &["--surface-map", "/dev/full"]);
+    assert_clean_failure(&run, &["/dev/full: cannot write"]);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "earlier result\n");
     let leftovers = std::fs::read_dir(&dir)
         .unwrap()
         .filter(|e| {
