@@ -3,7 +3,8 @@
 //! library's PLY writer and with the small OFF/OBJ/XYZ writers below), a tetrahedron, a cube
 //! of quads, a grid, its triangle soup, a sampled point cloud, and the edge cases the readers
 //! accept (comments, CRLF, polygons, negative OBJ indices, colours and normals, other
-//! elements, both byte orders, every PLY type).
+//! elements, both byte orders, every PLY type), and values files (`read_values`: blanks,
+//! commas, comments, wide integers, and the refused empty field and non-ASCII separator).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -436,10 +437,28 @@ fn pair_files(dir: &Path) {
     }
 }
 
+/// Values files (`read_values`): the first byte is the row count, the rest the file.
+fn values(dir: &Path) {
+    let w = |n: &str, rows: u8, text: &str| {
+        let mut bytes = vec![rows];
+        bytes.extend_from_slice(text.as_bytes());
+        write(dir, "read_values", n, bytes);
+    };
+    w("blanks.txt", 3, "1 2 3\n4\t5 6\n7 8 9\n");
+    w("commas-crlf.txt", 2, "0.5, 0.25,1e-3\r\n-2,3.5,+4\r\n");
+    w("comments.txt", 2, "\u{feff}# weights\n\n0.1 0.9 # first\n  1 0\n");
+    w("wide-integers.txt", 3, "9007199254740993\n18446744073709551615\n-9223372036854775808\n");
+    w("floats.txt", 2, "1e20 4e16 -1e300\n1e-300 .5 5.\n");
+    w("empty-field.txt", 1, "0.5,,0.25\n");
+    w("nbsp.txt", 1, "1\u{a0}2 3\n");
+    w("ragged.txt", 2, "1 2\n3\n");
+}
+
 fn main() {
     let dir = std::env::args().nth(1).unwrap_or_else(|| "corpus".into());
     let dir = Path::new(&dir);
     readers(dir);
+    values(dir);
     shape_targets(dir);
     params(dir);
     pair_files(dir);

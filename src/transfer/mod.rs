@@ -1,9 +1,12 @@
 //! Carrying per-vertex data from A to B through a [`SurfaceMap`] (docs/transfer.md):
 //! continuous values interpolated, labels taken from the nearest vertex, skin weights
 //! interpolated and renormalised; per-corner data (texture coordinates) with its seams
-//! ([`SurfaceMap::transfer_corners`]).
+//! ([`SurfaceMap::transfer_corners`]); values files read exactly ([`read_values`]).
 
 mod corners;
+mod values;
+
+pub use values::{parse_values, read_values, Values};
 
 use crate::maps::surface::SurfaceMap;
 use crate::{Error, Result};

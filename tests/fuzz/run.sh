@@ -33,7 +33,7 @@ if [[ $# -ge 1 && $1 =~ ^[0-9]+$ ]]; then
 fi
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then
-    targets=(read_off read_obj read_ply read_ply_binary read_xyz read_pairs shape_new ffi_shape_new ffi_params)
+    targets=(read_off read_obj read_ply read_ply_binary read_xyz read_pairs read_values shape_new ffi_shape_new ffi_params)
 fi
 
 if ! cargo +nightly --version >/dev/null 2>&1; then

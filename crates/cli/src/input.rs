@@ -1,6 +1,7 @@
 //! Reading the input shapes: the repairs (on unless `--no-repair`), errors naming the side
 //! and the file, and the repairs made printed on stderr, one line each, naming the input.
 
+use crate::output::errln;
 use std::path::{Path, PathBuf};
 
 use shapecorr::{Error, ReadAs, Repairs, Shape};
@@ -30,7 +31,7 @@ pub fn read_input(side: char, path: &Path, points: bool, no_repair: bool) -> Res
         e => naming_files(e.in_shape(side), path, path),
     })?;
     for warning in shape.warnings().iter().filter(|w| w.is_repair()) {
-        eprintln!("shapecorr: repaired {side} ({}): {warning}", path.display());
+        errln!("shapecorr: repaired {side} ({}): {warning}", path.display());
     }
     Ok(shape)
 }

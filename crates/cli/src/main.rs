@@ -130,7 +130,7 @@ fn run(cli: &Cli) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("shapecorr: {e}");
+            output::errln!("shapecorr: {e}");
             ExitCode::FAILURE
         }
     }

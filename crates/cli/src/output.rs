@@ -1,6 +1,7 @@
-//! What the commands write: JSON files, coloured PLYs, map files, and the progress line.
+//! What the commands write: standard output (errors returned, never a panic), JSON files,
+//! coloured PLYs, map files, output files written whole or not at all, and the progress line.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde_json::json;
 use shapecorr::colors::{coordinate_colors, region_colors};
@@ -10,6 +11,47 @@ use shapecorr::pipeline::Correspondence;
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::{Error, Shape};
+
+/// `println!` that returns an error instead of panicking when standard output cannot be
+/// written (`> /dev/full`, a full disk). A closed pipe (`| head`) ends the tool quietly
+/// (SIGPIPE, main.rs).
+macro_rules! outln {
+    () => {
+        $crate::output::write_stdout(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::output::write_stdout(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+pub(crate) use outln;
+
+/// `print!` as [`outln`].
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::output::write_stdout(format_args!($($arg)*))
+    };
+}
+pub(crate) use out;
+
+/// `eprintln!` that never panics: when standard error cannot be written, nothing can be
+/// said there, and the exit status still tells.
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+pub(crate) use errln;
+
+/// Writes to standard output and flushes: what [`outln`] and [`out`] call.
+pub fn write_stdout(args: std::fmt::Arguments) -> Result<(), Error> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_fmt(args)
+        .and_then(|()| stdout.flush())
+        .map_err(|e| Error::file("standard output", format!("cannot write: {e}")))
+}
 
 /// No progress at all (`--quiet`).
 pub static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -71,13 +113,148 @@ impl Progress for TerminalProgress {
 pub fn end_progress_line() {
     use std::io::IsTerminal;
     if std::io::stderr().is_terminal() && !QUIET.load(std::sync::atomic::Ordering::Relaxed) {
-        eprintln!();
+        errln!();
     }
 }
 
-/// Creates the output folder `out`.
+/// Creates the output folder `out` (`--out`); says what to do when `out` is a file.
 pub fn create_dir(out: &Path) -> Result<(), Error> {
-    std::fs::create_dir_all(out).map_err(|e| Error::file(out, e.to_string()))
+    if out.exists() && !out.is_dir() {
+        return Err(Error::file(
+            out,
+            "`--out` names the folder the results are written into, and this is a file: \
+             choose a folder (created if missing), or remove the file",
+        ));
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| Error::file(out, format!("cannot create the output folder: {e}")))
+}
+
+/// [`create_dir`] for the files `names`, after checking that none of them is one of
+/// `inputs` ([`refuse_inputs`]): a result never replaces an input.
+pub fn create_out_dir(out: &Path, names: &[&str], inputs: &[&Path]) -> Result<(), Error> {
+    let files: Vec<PathBuf> = names.iter().map(|n| out.join(n)).collect();
+    refuse_inputs(
+        &files.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
+        inputs,
+    )?;
+    create_dir(out)
+}
+
+/// Refuses when an output is one of the inputs, or two outputs are one file: the same file
+/// also through a hard or symbolic link (`same-file` compares device and inode, or the
+/// Windows file index).
+pub fn refuse_inputs(outputs: &[&Path], inputs: &[&Path]) -> Result<(), Error> {
+    for (k, output) in outputs.iter().enumerate() {
+        for input in inputs {
+            if same_file::is_same_file(output, input).unwrap_or(false) {
+                return Err(Error::file(
+                    output,
+                    format!(
+                        "is the input {}: an output never replaces an input; write it \
+                         elsewhere",
+                        input.display()
+                    ),
+                ));
+            }
+        }
+        let twice = outputs[..k]
+            .iter()
+            .any(|o| o == output || same_file::is_same_file(o, output).unwrap_or(false));
+        if twice {
+            return Err(Error::file(
+                output,
+                "named for two outputs; give each its own file",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `path` can be an output file: not a folder, in a folder that exists.
+/// Done before the work, so that a wrong path fails at once.
+pub fn check_output_file(path: &Path) -> Result<(), Error> {
+    if path.is_dir() {
+        return Err(Error::file(path, "is a folder; name the file to write"));
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        return Err(Error::file(
+            path,
+            format!("the folder {} does not exist", parent.display()),
+        ));
+    }
+    Ok(())
+}
+
+/// Writes every file of `files` whole, or none of them where it can: each is first written
+/// to a temporary file in its destination's folder, and the temporary files replace the
+/// destinations only when all are written. An existing destination that is not a regular
+/// file (`/dev/null`, a FIFO) is written in place, before the others are renamed; a
+/// symbolic link is followed.
+pub fn write_files(files: &[(&Path, &[u8])]) -> Result<(), Error> {
+    let mut staged = Vec::with_capacity(files.len());
+    for &(path, bytes) in files {
+        staged.push(Staged::write(path, bytes)?);
+    }
+    // Files written in place first: they are the ones whose writing can still fail.
+    staged.sort_by_key(|file| matches!(file, Staged::Temporary(..)));
+    for file in staged {
+        file.commit()?;
+    }
+    Ok(())
+}
+
+/// A file of [`write_files`] written but not yet in place.
+enum Staged<'a> {
+    Temporary(tempfile::NamedTempFile, PathBuf),
+    InPlace(&'a Path, &'a [u8]),
+}
+
+impl<'a> Staged<'a> {
+    fn write(path: &'a Path, bytes: &'a [u8]) -> Result<Staged<'a>, Error> {
+        use std::io::Write;
+        let cannot = |e: std::io::Error| Error::file(path, format!("cannot write: {e}"));
+        match std::fs::metadata(path) {
+            Ok(meta) if meta.is_dir() => {
+                return Err(Error::file(path, "is a folder; name the file to write"))
+            }
+            Ok(meta) if !meta.is_file() => return Ok(Staged::InPlace(path, bytes)),
+            _ => {}
+        }
+        let target = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        let folder = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(".shapecorr-");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            // As a file created in place: read-write for all, less the umask.
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let mut temp = builder.tempfile_in(folder).map_err(cannot)?;
+        temp.write_all(bytes)
+            .and_then(|()| temp.as_file().sync_all())
+            .map_err(cannot)?;
+        Ok(Staged::Temporary(temp, target))
+    }
+
+    fn commit(self) -> Result<(), Error> {
+        match self {
+            Staged::Temporary(temp, target) => temp
+                .persist(&target)
+                .map(drop)
+                .map_err(|e| Error::file(&target, format!("cannot write: {}", e.error))),
+            Staged::InPlace(path, bytes) => std::fs::write(path, bytes)
+                .map_err(|e| Error::file(path, format!("cannot write: {e}"))),
+        }
+    }
 }
 
 pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), Error> {
@@ -197,7 +374,7 @@ pub fn confidence_summary(verdict: Option<&Verdict>) -> String {
 /// Prints the verdict's warning on stderr, one line, when the answer is doubtful.
 pub fn print_warning(verdict: Option<&Verdict>) {
     if let Some(warning) = verdict.and_then(Verdict::warning) {
-        eprintln!("shapecorr: warning: {}", warning.replace(['\n', '\r'], " "));
+        errln!("shapecorr: warning: {}", warning.replace(['\n', '\r'], " "));
     }
 }
 

@@ -1,6 +1,7 @@
 //! `shapecorr bench`: region accuracy (`regions`), pointwise maps (`p2p`), maps made by
 //! other tools (`maps`) and the paper's whole evaluation (`all`) on the research datasets.
 
+use crate::output::{errln, out, outln};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -95,7 +96,7 @@ impl BenchRegionsArgs {
                 dir: self.basis_cache.clone(),
             },
             &mut |i, n, r| {
-                eprintln!(
+                errln!(
                     "[{}/{}] {} -> {} ({}): symmetric {:.3}, one-to-one {:.3}{}, regions {}/{}, coverage {:.3}, k {}, {:.2} s",
                     i + 1,
                     n,
@@ -115,16 +116,16 @@ impl BenchRegionsArgs {
                 );
             },
         )?;
-        println!(
+        outln!(
             "shapecorr {} bench regions --pairs {} ({} pairs, {:.0} s wall)",
             env!("CARGO_PKG_VERSION"),
             self.pairs.display(),
             results.len(),
             started.elapsed().as_secs_f64()
-        );
-        print!("{}", shapecorr_eval::bench::summary_table(&results));
-        println!();
-        print!("{}", shapecorr_eval::bench::region_tails_table(&results));
+        )?;
+        out!("{}", shapecorr_eval::bench::summary_table(&results))?;
+        outln!()?;
+        out!("{}", shapecorr_eval::bench::region_tails_table(&results))?;
         Ok(())
     }
 }
@@ -179,23 +180,23 @@ impl BenchP2pArgs {
             },
             &mut print_pair_scores,
         )?;
-        println!(
+        outln!(
             "shapecorr {} bench p2p --pairs {} ({} pairs, {} samples per pair, {:.0} s wall)",
             env!("CARGO_PKG_VERSION"),
             self.pairs.display(),
             results.len(),
             self.samples,
             started.elapsed().as_secs_f64()
-        );
-        print!(
+        )?;
+        out!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_table(&results)
-        );
-        println!("\nTails (mean error per pair against the ground truth, no flip):\n");
-        print!(
+        )?;
+        outln!("\nTails (mean error per pair against the ground truth, no flip):\n")?;
+        out!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_tails_table(&results)
-        );
+        )?;
         if let Some(path) = &self.json {
             write_scores_json(path, &results)?;
         }
@@ -205,7 +206,7 @@ impl BenchP2pArgs {
                 .file_stem()
                 .map_or(String::new(), |s| s.to_string_lossy().into_owned());
             if !shapecorr_eval::bench_pointwise::write_curves(path, &name, &results)? {
-                eprintln!(
+                errln!(
                     "shapecorr: no font found, {} has no text (set SHAPECORR_FONT)",
                     path.with_extension("png").display()
                 );
@@ -294,12 +295,12 @@ impl BenchAllArgs {
         }
         let started = Instant::now();
         let page = shapecorr_eval::bench_all::run_all(&p)?;
-        println!(
+        outln!(
             "{} written ({:.0} s); logs and eigenbasis cache in {}",
             page.display(),
             started.elapsed().as_secs_f64(),
             p.work.display()
-        );
+        )?;
         Ok(())
     }
 }
@@ -330,15 +331,15 @@ impl BenchMapsArgs {
             self.limit,
             &mut print_pair_scores,
         )?;
-        print!(
+        out!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_table(&results)
-        );
-        println!("\nTails (mean error per pair against the ground truth, no flip):\n");
-        print!(
+        )?;
+        outln!("\nTails (mean error per pair against the ground truth, no flip):\n")?;
+        out!(
             "{}",
             shapecorr_eval::bench_pointwise::pointwise_tails_table(&results)
-        );
+        )?;
         if let Some(path) = &self.json {
             write_scores_json(path, &results)?;
         }
@@ -355,7 +356,7 @@ fn print_pair_scores(i: usize, n: usize, r: &PairScores) {
             None => format!("{} {:.4}", s.method, s.error.mean),
         })
         .collect();
-    eprintln!(
+    errln!(
         "[{}/{}] {} -> {} ({}): {}",
         i + 1,
         n,
@@ -433,7 +434,7 @@ impl BenchTailsArgs {
         }
         let page = shapecorr_eval::bench_tails::tails_page(&records, &command);
         std::fs::write(&self.out, &page).map_err(|e| Error::file(&self.out, e.to_string()))?;
-        print!("{page}");
+        out!("{page}")?;
         Ok(())
     }
 }
@@ -493,7 +494,7 @@ impl BenchScaleArgs {
         let png = self.out.with_extension("png");
         let page = shapecorr_eval::bench_scale::scale_page(&records, &command, &png)?;
         std::fs::write(&self.out, &page).map_err(|e| Error::file(&self.out, e.to_string()))?;
-        print!("{page}");
+        out!("{page}")?;
         Ok(())
     }
 }

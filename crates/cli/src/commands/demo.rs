@@ -1,6 +1,7 @@
 //! `shapecorr demo`: two generated humanoids in different poses, one a noisy point cloud,
 //! matched (regions, then the point-to-point map) and scored against the known ground truth.
 
+use crate::output::{errln, outln};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -41,12 +42,12 @@ impl DemoArgs {
         let mesh_a = synth::figure(&spec(0))?;
         let mesh_b = synth::figure(&spec(3))?;
         let cloud_b = synth::sample_points(&mesh_b, vertices, 0.005, 1)?;
-        println!(
+        outln!(
             "A: humanoid, rest pose, mesh of {} vertices; B: humanoid, pose 3, point cloud of {} points with noise 0.5% of the width ({:.2} s)",
             mesh_a.vertices.len(),
             cloud_b.points.len(),
             t.elapsed().as_secs_f64()
-        );
+        )?;
         let a = Shape::mesh(mesh_a.vertices.clone(), &mesh_a.triangles)?;
         let b = Shape::point_cloud(cloud_b.points.clone())?;
         let params = Params::default();
@@ -69,7 +70,7 @@ impl DemoArgs {
         );
         end_progress_line();
         let result = result?;
-        eprintln!();
+        errln!();
         write_json(
             &out.join("result.json"),
             &correspondence_json(&a, &b, &result),
@@ -96,7 +97,7 @@ impl DemoArgs {
             &truth,
             Some(&flipped),
         );
-        println!(
+        outln!(
             "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one ({:.2} s after the eigenbases)",
             result.k,
             result.graph_a.n_nodes(),
@@ -104,15 +105,15 @@ impl DemoArgs {
             result.matches.len(),
             result.matches_one_to_one.len(),
             result.timings.total
-        );
-        println!(
+        )?;
+        outln!(
             "region accuracy against the ground truth: symmetric {:.3}, one-to-one {:.3}, one-to-one allowing a left/right flip {:.3} (coverage {:.3}, unmatched {:.3})",
             scores.symmetric,
             scores.one_to_one,
             scores.one_to_one_flip.unwrap_or(f64::NAN),
             scores.coverage,
             scores.unmatched
-        );
+        )?;
         // Point-to-point map from the regions (functional map + ZoomOut).
         let map = PointwiseMap::from_bases(
             ShapeBasis::new(&a, &full_a),
@@ -124,13 +125,13 @@ impl DemoArgs {
         write_map(&out.join("map_b_to_a.txt"), &map.p2p_ba)?;
         write_map_colors(out, &a, &b, &map.p2p_ba)?;
         report_map(&a, &full_a, &map, &truth, &flipped)?;
-        println!(
+        outln!(
             "coloured shapes: {} and {}; the map: {} and {} (open them in MeshLab or Blender)",
             out.join("a_regions.ply").display(),
             out.join("b_regions.ply").display(),
             out.join("a_colors.ply").display(),
             out.join("b_mapped.ply").display()
-        );
+        )?;
         Ok(())
     }
 }
@@ -162,12 +163,12 @@ fn report_map(
     } else {
         plain
     };
-    println!(
+    outln!(
         "point-to-point map ({:.2} s): mean geodesic error {:.4} of sqrt(area) ({}), {:.1}% of the points within 0.05",
         map.timings.fmap + map.timings.refinement,
         best.mean,
         if mirrored.mean < plain.mean { "a left/right mirror image" } else { "not mirrored" },
         100.0 * best.within_005
-    );
+    )?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! `shapecorr eigen`: Laplacian eigenvalues of a shape, with time and peak memory.
 
 use crate::input::read_shape;
+use crate::output::outln;
 use crate::output::peak_memory_mib;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -68,23 +69,23 @@ impl EigenArgs {
                 "timings_s": {"read": t_read, "laplacian": t_laplacian, "eigensolve": t_eigen},
                 "peak_memory_mib": peak,
             });
-            println!(
+            outln!(
                 "{}",
                 serde_json::to_string_pretty(&value).unwrap_or_default()
-            );
+            )?;
         } else {
-            println!(
+            outln!(
                 "{}: {} vertices, {} eigenpairs (unit-area shape)",
                 file.display(),
                 shape.n_vertices(),
                 values.len()
-            );
-            println!(
+            )?;
+            outln!(
                 "time: read {t_read:.3} s, laplacian {t_laplacian:.3} s, eigensolve {t_eigen:.3} s; peak memory {}",
                 peak.map_or("unknown".to_string(), |p| format!("{p:.1} MiB"))
-            );
+            )?;
             for (i, v) in values.iter().enumerate() {
-                println!("{i:4} {v:.12e}");
+                outln!("{i:4} {v:.12e}")?;
             }
         }
         Ok(())

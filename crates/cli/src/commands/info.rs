@@ -1,6 +1,7 @@
 //! `shapecorr info`: counts, area, pieces and warnings of a shape file.
 
 use crate::input::read_shape;
+use crate::output::outln;
 use std::path::PathBuf;
 
 use serde_json::json;
@@ -44,20 +45,20 @@ impl InfoArgs {
                 "n_pieces": shape.n_pieces(),
                 "warnings": warnings,
             });
-            println!(
+            outln!(
                 "{}",
                 serde_json::to_string_pretty(&value).unwrap_or_default()
-            );
+            )?;
         } else {
-            println!("file:        {}", file.display());
-            println!("kind:        {kind}");
-            println!("vertices:    {}", shape.n_vertices());
-            println!("faces:       {}", shape.triangles().len());
-            println!("area:        {:.6e}", laplacian.input_area);
-            println!("width:       {:.6e}", shape.width());
-            println!("pieces:      {}", shape.n_pieces());
+            outln!("file:        {}", file.display())?;
+            outln!("kind:        {kind}")?;
+            outln!("vertices:    {}", shape.n_vertices())?;
+            outln!("faces:       {}", shape.triangles().len())?;
+            outln!("area:        {:.6e}", laplacian.input_area)?;
+            outln!("width:       {:.6e}", shape.width())?;
+            outln!("pieces:      {}", shape.n_pieces())?;
             for w in warnings {
-                println!("warning:     {w}");
+                outln!("warning:     {w}")?;
             }
         }
         Ok(())

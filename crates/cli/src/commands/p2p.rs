@@ -1,5 +1,6 @@
 //! `shapecorr p2p`: the point-to-point map from B to A (regions, functional map, ZoomOut).
 
+use crate::output::outln;
 use std::path::PathBuf;
 
 use serde_json::json;
@@ -9,7 +10,7 @@ use shapecorr::PointwiseCorrespondence;
 use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
 use crate::output::{
-    budget_json, confidence_summary, correspondence_json, create_dir, end_progress_line,
+    budget_json, confidence_summary, correspondence_json, create_out_dir, end_progress_line,
     options_json, print_warning, set_verdict_json, write_colored, write_json, write_map,
     write_map_colors, TerminalProgress,
 };
@@ -28,9 +29,17 @@ pub struct P2pArgs {
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
-        let (shape_a, shape_b) = self.pair.read()?;
         let out = &self.out;
-        create_dir(out)?;
+        let names = [
+            "map_b_to_a.txt",
+            "result.json",
+            "a_regions.ply",
+            "b_regions.ply",
+            "a_colors.ply",
+            "b_mapped.ply",
+        ];
+        create_out_dir(out, &names, &[&self.pair.a, &self.pair.b])?;
+        let (shape_a, shape_b) = self.pair.read()?;
         let result = PointwiseCorrespondence::compute(
             &shape_a,
             &shape_b,
@@ -59,7 +68,7 @@ impl P2pArgs {
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result.regions)?;
         write_map_colors(out, &shape_a, &shape_b, map)?;
-        println!(
+        outln!(
             "map of {} vertices of B onto A ({} one-to-one region matches, functional map {}x{}, {}); {:.2} s -> {}",
             map.len(),
             result.regions.matches_one_to_one.len(),
@@ -68,7 +77,7 @@ impl P2pArgs {
             confidence_summary(result.verdict()),
             result.total,
             out.display()
-        );
+        )?;
         print_warning(result.verdict());
         Ok(())
     }

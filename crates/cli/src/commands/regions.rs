@@ -1,6 +1,7 @@
 //! `shapecorr match` (region correspondence of two shapes) and `shapecorr symmetry` (the
 //! symmetric regions of one shape).
 
+use crate::output::outln;
 use std::path::PathBuf;
 
 use serde_json::json;
@@ -10,9 +11,12 @@ use shapecorr::Error;
 use crate::input::{read_input, ShapePairArgs};
 use crate::options::RegionOptions;
 use crate::output::{
-    budget_json, confidence_summary, correspondence_json, create_dir, end_progress_line,
+    budget_json, confidence_summary, correspondence_json, create_out_dir, end_progress_line,
     graph_json, options_json, print_warning, write_colored, write_json, TerminalProgress,
 };
+
+/// The files `match` writes into its folder.
+pub const MATCH_FILES: [&str; 3] = ["result.json", "a_regions.ply", "b_regions.ply"];
 
 #[derive(clap::Args)]
 pub struct MatchArgs {
@@ -28,9 +32,9 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let (shape_a, shape_b) = self.pair.read()?;
         let out = &self.out;
-        create_dir(out)?;
+        create_out_dir(out, &MATCH_FILES, &[&self.pair.a, &self.pair.b])?;
+        let (shape_a, shape_b) = self.pair.read()?;
         let result = Correspondence::compute(
             &shape_a,
             &shape_b,
@@ -46,7 +50,7 @@ impl MatchArgs {
         }
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result)?;
-        println!(
+        outln!(
             "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one ({}); {:.2} s -> {}",
             result.k,
             result.graph_a.n_nodes(),
@@ -56,7 +60,7 @@ impl MatchArgs {
             confidence_summary(result.verdict.as_ref()),
             result.timings.total,
             out.display()
-        );
+        )?;
         print_warning(result.verdict.as_ref());
         Ok(())
     }
@@ -81,9 +85,9 @@ pub struct SymmetryArgs {
 impl SymmetryArgs {
     pub fn run(&self) -> Result<(), Error> {
         let options = self.options.options()?;
-        let shape = read_input('A', &self.a, self.points, self.no_repair)?;
         let out = &self.out;
-        create_dir(out)?;
+        create_out_dir(out, &["a_symmetry.ply", "result.json"], &[&self.a])?;
+        let shape = read_input('A', &self.a, self.points, self.no_repair)?;
         let symmetry = Symmetry::detect(&shape, &options.params, &mut TerminalProgress::new());
         end_progress_line();
         let symmetry = symmetry?;
@@ -107,12 +111,12 @@ impl SymmetryArgs {
             }),
         )?;
         let symmetric_groups = symmetry.groups.iter().filter(|g| g.len() > 1).count();
-        println!(
+        outln!(
             "{} regions, {} groups of symmetric regions -> {}",
             symmetry.graph.n_nodes(),
             symmetric_groups,
             out.display()
-        );
+        )?;
         Ok(())
     }
 }

@@ -1,5 +1,6 @@
 //! `shapecorr synth`: an articulated test figure, as a mesh or a sampled point cloud.
 
+use crate::output::outln;
 use std::path::PathBuf;
 
 use shapecorr::synth::{self, FigureKind, FigureSpec, Proportions};
@@ -60,12 +61,12 @@ impl SynthArgs {
         match self.points {
             None => {
                 shapecorr::shape::io::write_ply(out, &mesh.vertices, &mesh.triangles, None)?;
-                println!(
+                outln!(
                     "{}: {} vertices, {} triangles",
                     out.display(),
                     mesh.vertices.len(),
                     mesh.triangles.len()
-                );
+                )?;
             }
             Some(n) => {
                 let cloud = synth::sample_points(&mesh, n, self.noise, self.seed)?;
@@ -77,12 +78,12 @@ impl SynthArgs {
                     .map(|v| format!("{v}\n"))
                     .collect();
                 std::fs::write(&gt_path, text).map_err(|e| Error::file(&gt_path, e.to_string()))?;
-                println!(
+                outln!(
                     "{}: {} points (ground-truth mesh vertex of every point in {})",
                     out.display(),
                     cloud.points.len(),
                     gt_path.display()
-                );
+                )?;
             }
         }
         Ok(())

@@ -2,16 +2,19 @@
 //! the surface map (docs/transfer.md).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use shapecorr::maps::surface::SurfaceMap;
-use shapecorr::transfer::TransferMode;
+use shapecorr::transfer::{read_values, TransferMode};
 use shapecorr::Error;
 use shapecorr::PointwiseCorrespondence;
 
 use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
-use crate::output::{confidence_summary, end_progress_line, print_warning, TerminalProgress};
+use crate::output::{
+    check_output_file, confidence_summary, end_progress_line, outln, print_warning, refuse_inputs,
+    write_files, TerminalProgress,
+};
 
 /// How the values are carried (the library's `TransferMode`).
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -29,16 +32,18 @@ pub struct TransferArgs {
     #[command(flatten)]
     pair: ShapePairArgs,
     /// Values on A: a text file with one row per vertex of A, in A's vertex order, numbers
-    /// separated by spaces, tabs or commas (every row the same count); `#` starts a comment.
+    /// separated by ASCII spaces, tabs or commas (every row the same count, no empty field);
+    /// `#` starts a comment. Integers are exact to 64 bits (docs/transfer.md, "Values files").
     #[arg(long)]
     values: PathBuf,
-    /// Where B's values are written: one row per vertex of B, in the same layout.
+    /// Where B's values are written: one row per vertex of B, in the same layout. Written
+    /// only when the whole job succeeded; never one of the inputs.
     #[arg(long)]
     out: PathBuf,
     #[arg(long, value_enum, default_value = "interpolate")]
     mode: Mode,
     /// With `--mode weights`: the most non-zero weights a vertex keeps (0: all).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value = "4", allow_negative_numbers = true, value_parser = influences)]
     max_influences: usize,
     /// Also write where every vertex of B lands on A: a row per vertex of B with three
     /// vertices of A and their three weights (`a0 a1 a2 w0 w1 w2`).
@@ -48,11 +53,32 @@ pub struct TransferArgs {
     options: PointwiseOptions,
 }
 
+/// `--max-influences`: a count, 0 for all; a negative number gets a message of its own
+/// rather than clap's "unexpected argument".
+fn influences(text: &str) -> Result<usize, String> {
+    match text.parse::<i128>() {
+        Ok(n) if n < 0 => Err(format!(
+            "{n} is negative: give the most weights a vertex keeps, or 0 to keep all"
+        )),
+        Ok(n) => Ok(usize::try_from(n).unwrap_or(usize::MAX)),
+        Err(_) => Err(format!(
+            "`{text}` is not a count: give the most weights a vertex keeps, or 0 to keep all"
+        )),
+    }
+}
+
 impl TransferArgs {
     pub fn run(&self) -> Result<(), Error> {
         let (options, pointwise) = self.options.pointwise()?;
+        let mut outputs = vec![self.out.as_path()];
+        outputs.extend(self.surface_map.as_deref());
+        let inputs = [self.pair.a.as_path(), &self.pair.b, &self.values];
+        refuse_inputs(&outputs, &inputs)?;
+        for path in &outputs {
+            check_output_file(path)?;
+        }
         let (shape_a, shape_b) = self.pair.read()?;
-        let (values, channels) = read_values(&self.values, shape_a.n_vertices())?;
+        let values = read_values(&self.values, shape_a.n_vertices())?;
         let mut progress = TerminalProgress::new();
         let result = PointwiseCorrespondence::compute(
             &shape_a,
@@ -75,89 +101,37 @@ impl TransferArgs {
                 max_influences: self.max_influences,
             },
         };
-        let carried = onto
-            .transfer(&values, channels, mode)
+        let carried = values
+            .transfer(&onto, mode)
             .map_err(|e| Error::file(&self.values, e.to_string()))?;
-        write_rows(&self.out, &carried, channels)?;
-        if let Some(path) = &self.surface_map {
-            write_surface_map(path, &onto)?;
-        }
-        println!(
+        let mut rows = Vec::new();
+        let _ = carried.write_text(&mut rows);
+        let map = self
+            .surface_map
+            .as_ref()
+            .map(|path| (path, surface_map_text(&onto)));
+        let mut files = vec![(self.out.as_path(), rows.as_slice())];
+        files.extend(map.as_ref().map(|(p, t)| (p.as_path(), t.as_bytes())));
+        write_files(&files)?;
+        outln!(
             "{} values a vertex carried to {} vertices of B ({}); {:.2} s -> {}",
-            channels,
+            values.channels(),
             shape_b.n_vertices(),
             confidence_summary(result.verdict()),
             result.total,
             self.out.display()
-        );
+        )?;
         print_warning(result.verdict());
         Ok(())
     }
 }
 
-/// A text matrix of `rows` rows: the values row-major and the column count.
-fn read_values(path: &Path, rows: usize) -> Result<(Vec<f64>, usize), Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e.to_string()))?;
-    let mut values = Vec::new();
-    let mut columns = None;
-    let mut count = 0;
-    for (number, line) in text.lines().enumerate() {
-        let line = line.split('#').next().unwrap_or("").trim();
-        if line.is_empty() {
-            continue;
-        }
-        let before = values.len();
-        for word in line.split(|c: char| c.is_whitespace() || c == ',') {
-            if word.is_empty() {
-                continue;
-            }
-            let value: f64 = word.parse().map_err(|_| {
-                Error::file(
-                    path,
-                    format!("line {}: `{word}` is not a number", number + 1),
-                )
-            })?;
-            values.push(value);
-        }
-        let width = values.len() - before;
-        match columns {
-            None => columns = Some(width),
-            Some(c) if c != width => {
-                return Err(Error::file(
-                    path,
-                    format!("line {} has {width} values, the first row {c}", number + 1),
-                ))
-            }
-            _ => {}
-        }
-        count += 1;
-    }
-    if count != rows {
-        return Err(Error::file(
-            path,
-            format!("{count} rows of values, but shape A has {rows} vertices (one row each)"),
-        ));
-    }
-    Ok((values, columns.unwrap_or(0)))
-}
-
-fn write_rows(path: &Path, values: &[f64], channels: usize) -> Result<(), Error> {
-    let mut text = String::with_capacity(values.len() * 10);
-    for row in values.chunks(channels.max(1)) {
-        for (i, x) in row.iter().enumerate() {
-            let _ = write!(text, "{}{x}", if i == 0 { "" } else { " " });
-        }
-        text.push('\n');
-    }
-    std::fs::write(path, text).map_err(|e| Error::file(path, e.to_string()))
-}
-
-fn write_surface_map(path: &Path, onto: &SurfaceMap) -> Result<(), Error> {
+fn surface_map_text(onto: &SurfaceMap) -> String {
     let mut text = String::with_capacity(onto.points.len() * 48);
     for point in &onto.points {
         let [v0, v1, v2] = point.vertices;
         let [w0, w1, w2] = point.weights;
         let _ = writeln!(text, "{v0} {v1} {v2} {w0} {w1} {w2}");
     }
-    std::fs::write(path, text).map_err(|e| Error::file(path, e.to_string()))
+    text
 }

@@ -6,32 +6,12 @@
 use std::ffi::OsString;
 use std::os::unix::ffi::OsStringExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::common;
 
-use common::shapecorr;
-
-/// Runs shapecorr, killing it after `limit`; `None` when it had to be killed.
-fn shapecorr_within<S: AsRef<std::ffi::OsStr>>(args: &[S], limit: Duration) -> Option<Output> {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_shapecorr"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let started = Instant::now();
-    while started.elapsed() < limit {
-        if child.try_wait().unwrap().is_some() {
-            return Some(child.wait_with_output().unwrap());
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
-    None
-}
+use common::{assert_clean_failure, shapecorr, shapecorr_within, stderr};
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch("hostile", name)
@@ -39,21 +19,6 @@ fn scratch(name: &str) -> PathBuf {
 
 fn synth(path: &Path, pose: &str) {
     common::synth_figure("humanoid", pose, "800", path);
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// Fails with one line on stderr (no panic) that contains every one of `needles`.
-fn assert_clean_failure(out: &Output, needles: &[&str]) {
-    let err = stderr(out);
-    assert!(!out.status.success(), "{err}");
-    assert_ne!(out.status.code(), Some(101), "panicked: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for needle in needles {
-        assert!(err.contains(needle), "`{needle}` not in: {err}");
-    }
 }
 
 #[test]

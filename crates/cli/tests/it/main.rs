@@ -6,5 +6,6 @@ mod batch;
 mod bench_all;
 mod cli;
 mod common;
+mod files;
 mod hostile;
 mod memory_cap;
