@@ -149,7 +149,7 @@ impl BatchArgs {
         let (mut computed, mut unusable) = (0, 0);
         for (i, shape, record) in records {
             if let Some(warning) = &record.warning {
-                eprintln!("shapecorr: warning: shape {}: {warning}", record.name);
+                crate::output::errln!("shapecorr: warning: shape {}: {warning}", record.name);
             }
             computed += usize::from(record.computed);
             unusable += usize::from(!record.ok);
@@ -182,7 +182,7 @@ impl BatchArgs {
         if let Some(e) = error {
             return Err(e);
         }
-        println!(
+        crate::output::outln!(
             "{} pairs ({} now, {} from an earlier run), {failed} failed now, {failed_before} \
              failed in an earlier run; {} shapes ({computed} eigenbases computed, {} from the \
              cache, {unusable} unusable) in {:.1} s; pairs {:.1} s; total {:.1} s -> {}",
@@ -195,7 +195,7 @@ impl BatchArgs {
             started.elapsed().as_secs_f64() - shape_seconds,
             started.elapsed().as_secs_f64(),
             self.out.join("pairs.jsonl").display()
-        );
+        )?;
         if failed + failed_before > 0 {
             return Err(Error::file(
                 self.out.join("pairs.jsonl"),
