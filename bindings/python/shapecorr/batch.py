@@ -26,6 +26,7 @@ import json
 import os
 import sys
 import threading
+import warnings
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, Optional, Tuple, Union
@@ -300,7 +301,8 @@ def match_pairs(
     runs (a second batch on it raises) and holds the settings in ``batch.json``: a folder
     of a batch with other settings, by this package or by ``shapecorr batch``, is refused.
     A shape whose eigenbasis could not be cached, or whose cache entry was damaged, gets a
-    ``warning`` in ``shapes.jsonl`` and is computed without the cache."""
+    ``warning`` in ``shapes.jsonl`` (and a ``RuntimeWarning``) and is computed without the
+    cache. Pairs that failed, now or in an earlier run, are counted in a ``RuntimeWarning``."""
     inputs = _inputs(shapes)
     todo_all = _pairs(pairs, inputs)
     out = Path(out)
@@ -327,16 +329,22 @@ def _run(inputs, todo_all, out, settings, client, workers, retry_failed, progres
     needed = sorted({i for pair in todo for i in pair})
     shape_log = _Log(out / "shapes.jsonl")
     total, finished = len(todo) + len(done), len(done)
+    wanted = {(inputs[i][0], inputs[j][0]) for i, j in todo_all}
+    latest = {(r["a"], r["b"]): bool(r.get("ok")) for r in log.records if (r["a"], r["b"]) in wanted}
+    failed_before = sum(not ok and pair in done for pair, ok in latest.items())
+    failed_now = 0
     job = lambda i: (inputs[i][0], str(inputs[i][1]))  # noqa: E731
     try:
         if client is None:
             with ThreadPoolExecutor(workers or os.cpu_count() or 1) as pool:
                 for record in pool.map(lambda i: prepare_task(settings, *job(i)), needed):
-                    shape_log.append(record)
+                    _shape_done(shape_log, record)
                 futures = {pool.submit(match_task, settings, job(i), job(j), str(out)): (i, j) for i, j in todo}
                 for future in as_completed(futures):
                     finished += 1
-                    _finish(log, _result(future, *(inputs[k][0] for k in futures[future])), progress, finished, total)
+                    record = _result(future, *(inputs[k][0] for k in futures[future]))
+                    failed_now += not record.get("ok")
+                    _finish(log, record, progress, finished, total)
         else:
             from distributed import as_completed as dask_completed
 
@@ -354,18 +362,36 @@ def _run(inputs, todo_all, out, settings, client, workers, retry_failed, progres
             for future in dask_completed(list(pair_futures)):
                 finished += 1
                 i, j = pair_futures[future]
-                _finish(log, _result(future, inputs[i][0], inputs[j][0]), progress, finished, total)
+                record = _result(future, inputs[i][0], inputs[j][0])
+                failed_now += not record.get("ok")
+                _finish(log, record, progress, finished, total)
                 future.release()
             for i, future in shape_futures.items():
                 try:
-                    shape_log.append(future.result())
+                    _shape_done(shape_log, future.result())
                 except Exception as error:  # the shape's task itself failed (its pairs say why)
                     shape_log.append({"name": inputs[i][0], "path": str(inputs[i][1]), "ok": False,
                                       "error": f"{type(error).__name__}: {error}"})
     finally:
         log.close()
         shape_log.close()
+    if failed_now + failed_before:
+        warnings.warn(
+            f"{failed_now + failed_before} of {total} pairs failed ({failed_now} now, {failed_before} in an "
+            f"earlier run); their records in {out / 'pairs.jsonl'} say why, and retry_failed=True computes "
+            "them again",
+            RuntimeWarning,
+            stacklevel=3,
+        )
     return out / "pairs.jsonl"
+
+
+def _shape_done(shape_log, record):
+    """Logs a shape's record; its cache warning (a damaged entry computed again, an entry
+    that could not be stored) becomes a Python warning too."""
+    shape_log.append(record)
+    if record.get("warning"):
+        warnings.warn(f"shape {record['name']}: {record['warning']}", RuntimeWarning, stacklevel=4)
 
 
 def _result(future, a, b):

@@ -111,7 +111,11 @@ def test_bad_entries_are_failed_pairs(figures, tmp_path):
                     + "".join(f"3 {i} {i + 1} {i + 2}\n" for i in range(8)))
     shapes = {"h0": figures / "h0.off", "h1": figures / "h1.off", "broken": tmp_path / "broken.ply", "tiny": tiny}
     out = tmp_path / "out"
-    batch.match_pairs(shapes, out, pairs=[("h0", "h1"), ("h0", "broken"), ("tiny", "h1")], workers=2)
+    with pytest.warns(RuntimeWarning, match=r"2 of 3 pairs failed \(2 now, 0 in an earlier run\)"):
+        batch.match_pairs(shapes, out, pairs=[("h0", "h1"), ("h0", "broken"), ("tiny", "h1")], workers=2)
+    # A resumed run reports them again.
+    with pytest.warns(RuntimeWarning, match=r"2 of 3 pairs failed \(0 now, 2 in an earlier run\)"):
+        batch.match_pairs(shapes, out, pairs=[("h0", "h1"), ("h0", "broken"), ("tiny", "h1")], workers=2)
     results = by_pair(out)
     assert results[("h0", "h1")]["ok"]
     assert not results[("h0", "broken")]["ok"]
@@ -204,3 +208,22 @@ def test_a_held_folder_or_other_settings_are_refused(figures, tmp_path):
         batch.match_pairs(shapes, out, workers=1)
     settings = json.loads((out / "batch.json").read_text())
     assert settings["options"]["k_max"] == 6 and "cache" not in settings
+
+
+def test_a_damaged_cache_entry_is_computed_again_with_a_warning(figures, tmp_path):
+    shapes = {"h0": figures / "h0.off", "h1": figures / "h1.off"}
+    cache = tmp_path / "cache"
+    batch.match_pairs(shapes, tmp_path / "first", cache=cache, workers=1)
+    expected = by_pair(tmp_path / "first")
+    # A copy of the cache (this process keeps the shapes prepared from the first one).
+    damaged = tmp_path / "damaged"
+    damaged.mkdir()
+    for entry in cache.glob("*.basis"):
+        (damaged / entry.name).write_bytes(entry.read_bytes())
+    entry = sorted(damaged.glob("*.basis"))[0]
+    data = bytearray(entry.read_bytes())
+    data[len(data) // 2] ^= 0x10
+    entry.write_bytes(bytes(data))
+    with pytest.warns(RuntimeWarning, match="checksum does not match"):
+        batch.match_pairs(shapes, tmp_path / "second", cache=damaged, workers=1)
+    assert by_pair(tmp_path / "second") == expected
