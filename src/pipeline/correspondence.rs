@@ -228,7 +228,7 @@ fn no_match(seg: &JointSegmentation, m: &GraphMatching, params: &Params) -> Erro
             name: "gap_ratio",
             reason: format!(
                 "{found}: {overlong} of the {} regions had more than max_symmetry_order = {} \
-                 candidates within a factor gap_ratio = {} of each other, so none was kept; \
+                 candidates within a factor gap_ratio = {:?} of each other, so none was kept; \
                  use a gap_ratio nearer 1 (default {}) or a larger max_symmetry_order \
                  (default {})",
                 n_a + n_b,
