@@ -6,6 +6,7 @@
 
 mod common;
 mod correspondence;
+mod dense_limits;
 mod determinism;
 mod fuzz_regressions;
 mod header;

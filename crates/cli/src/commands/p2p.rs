@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use serde_json::json;
+use shapecorr::pipeline::PairJob;
 use shapecorr::Error;
 use shapecorr::PointwiseCorrespondence;
 
@@ -27,8 +28,20 @@ pub struct P2pArgs {
 
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
-        let (options, pointwise) = self.options.pointwise()?;
-        let (shape_a, shape_b) = self.pair.read()?;
+        let (mut options, pointwise) = self.options.pointwise()?;
+        let mut progress = TerminalProgress::new();
+        let mut budget = options.params.budget.clone();
+        let job = PairJob {
+            params: &options.params,
+            map: Some(&pointwise),
+        };
+        let read = self.pair.read_in_budget(
+            &mut budget,
+            |files| job.check_files(files).map(|_| ()),
+            &mut progress,
+        );
+        let (shape_a, shape_b) = read.inspect_err(|_| end_progress_line())?;
+        options.params.budget = budget;
         let out = &self.out;
         create_dir(out)?;
         let result = PointwiseCorrespondence::compute(
@@ -36,7 +49,7 @@ impl P2pArgs {
             &shape_b,
             &options.params,
             &pointwise,
-            &mut TerminalProgress::new(),
+            &mut progress,
         );
         end_progress_line();
         let result = result.map_err(|e| self.pair.naming(e))?;
