@@ -128,9 +128,9 @@ impl Proxy {
 }
 
 /// Triangles per piece of a dense mesh's first simplification pass: meshoptimizer's
-/// simplification is one call that cannot be interrupted, and takes about 1 s per 500K
-/// triangles on the 2-core reference machine, so a piece of this size bounds the wait for a
-/// cancel to about 0.2 s (docs/decisions.md, "Dense shapes: limits").
+/// simplification is one call that cannot be interrupted, so a piece bounds the wait for a
+/// cancel: 0.62 s measured on 2 cores under a load of 13 (docs/decisions.md, "Dense shapes:
+/// limits").
 pub const PIECE_TRIANGLES: usize = 100_000;
 
 /// What the first pass keeps of a dense mesh: this many times the proxy's triangles, so that
