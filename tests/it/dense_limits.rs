@@ -103,10 +103,12 @@ fn a_ceiling_the_declared_sizes_cannot_meet_is_refused_before_reading() {
         (size.vertices, size.faces),
         (icosphere(8).0.len(), icosphere(8).1.len())
     );
-    let mut params = Params::default();
-    params.budget = Budget {
-        memory_limit_mib: 100,
-        ..Budget::default()
+    let mut params = Params {
+        budget: Budget {
+            memory_limit_mib: 100,
+            ..Budget::default()
+        },
+        ..Params::default()
     };
     let job = PairJob {
         params: &params,

@@ -44,6 +44,29 @@ impl Progress for CancelIn {
     }
 }
 
+/// Reads A (the reading stages) or matches the pair (read once, outside the clock).
+fn run(
+    stage: Stage,
+    (a, b): (&Path, &Path),
+    repairs: &Repairs,
+    shapes: &mut Option<(Shape, Shape)>,
+    progress: &mut CancelIn,
+) -> Result<(), Error> {
+    if stage == Stage::Reading {
+        Shape::read_watched(a, ReadAs::Auto, repairs, progress)?;
+        return Ok(());
+    }
+    if shapes.is_none() {
+        *shapes = Some((
+            Shape::read_with(a, ReadAs::Auto, repairs)?,
+            Shape::read_with(b, ReadAs::Auto, repairs)?,
+        ));
+    }
+    let (sa, sb) = shapes.as_ref().expect("read above");
+    Correspondence::compute(sa, sb, &Params::default(), progress)?;
+    Ok(())
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (a, b) = (Path::new(&args[0]), Path::new(&args[1]));
@@ -70,21 +93,7 @@ fn main() {
             last: Instant::now(),
         };
         let started = Instant::now();
-        let result = (|| -> Result<(), Error> {
-            if stage == Stage::Reading {
-                Shape::read_watched(a, ReadAs::Auto, &repairs, &mut progress)?;
-                return Ok(());
-            }
-            if shapes.is_none() {
-                shapes = Some((
-                    Shape::read_with(a, ReadAs::Auto, &repairs)?,
-                    Shape::read_with(b, ReadAs::Auto, &repairs)?,
-                ));
-            }
-            let (sa, sb) = shapes.as_ref().expect("read above");
-            Correspondence::compute(sa, sb, &Params::default(), &mut progress)?;
-            Ok(())
-        })();
+        let result = run(stage, (a, b), &repairs, &mut shapes, &mut progress);
         let returned = Instant::now();
         let latency = progress.asked.map(|t| (returned - t).as_secs_f64());
         println!(
