@@ -59,6 +59,10 @@
 // Carrying data from A to B (`sc_surface_map_new`).
 #define SC_STAGE_TRANSFER 9
 
+// Reading a shape file and repairing the shape (front ends that read files as part of a
+// job; `sc_shape_read` itself takes no callback).
+#define SC_STAGE_READING 10
+
 // `sc_batch_new` flag: point-to-point maps too (as `sc_pointwise_map`), each written to
 // `OUT_DIR/maps/A--B.u32` (a vertex of A for every vertex of B, little-endian u32).
 #define SC_BATCH_MAPS 1

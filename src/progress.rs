@@ -24,6 +24,9 @@ pub enum Stage {
     Proxy = 8,
     /// Carrying data from A to B: the surface map and the transfer ([`crate::transfer`]).
     Transfer = 9,
+    /// Reading a shape file and validating and repairing the shape
+    /// ([`crate::Shape::read_watched`]).
+    Reading = 10,
 }
 
 /// Receives progress and may cancel: `report` returns `false` to stop the work, which then

@@ -67,6 +67,9 @@ pub const SC_STAGE_POINTWISE_MAP: u32 = 7;
 pub const SC_STAGE_PROXY: u32 = 8;
 /// Carrying data from A to B (`sc_surface_map_new`).
 pub const SC_STAGE_TRANSFER: u32 = 9;
+/// Reading a shape file and repairing the shape (front ends that read files as part of a
+/// job; `sc_shape_read` itself takes no callback).
+pub const SC_STAGE_READING: u32 = 10;
 
 /// Progress callback: called on the calling thread with a stage (`SC_STAGE_*`) and the
 /// fraction of that stage done (0 to 1). Return `false` to cancel: the call then returns
@@ -147,6 +150,7 @@ mod tests {
         assert_eq!(SC_STAGE_POINTWISE_MAP, Stage::PointwiseMap as u32);
         assert_eq!(SC_STAGE_PROXY, Stage::Proxy as u32);
         assert_eq!(SC_STAGE_TRANSFER, Stage::Transfer as u32);
+        assert_eq!(SC_STAGE_READING, Stage::Reading as u32);
     }
 
     /// The handles' thread-safety promises in the header rest on these.

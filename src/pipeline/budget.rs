@@ -14,6 +14,7 @@
 use std::time::{Duration, Instant};
 
 use crate::progress::{Progress, Stage};
+use crate::shape::io::DeclaredSize;
 use crate::spectral::eigen::{effective_threads, eigensolver_bytes, EigenParams, CONCURRENT_BELOW};
 use crate::{Error, Result};
 
@@ -26,6 +27,10 @@ pub struct Budget {
     pub memory_limit_mib: u64,
     /// Longest a job may run, in seconds; 0 is no limit. Default [`DEFAULT_TIME_LIMIT_S`].
     pub time_limit_s: f64,
+    /// When the time limit's clock started; `None` (the default): when the job starts. A
+    /// front end that reads the shapes as part of the job sets it before reading
+    /// ([`Budget::run`] on the reading too).
+    pub started: Option<Instant>,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -41,6 +46,7 @@ impl Default for Budget {
         Budget {
             memory_limit_mib: 0,
             time_limit_s: DEFAULT_TIME_LIMIT_S,
+            started: None,
             non_exhaustive: crate::NonExhaustive(()),
         }
     }
@@ -66,8 +72,12 @@ impl Estimate {
 /// The work of one job: the two shapes' sizes and what is computed on them.
 #[derive(Debug, Clone, Copy)]
 pub struct Job {
-    /// Active vertices of shape A and shape B (the same shape twice for a symmetry job).
+    /// Active vertices of shape A and shape B (the same shape twice for a symmetry job): of
+    /// their proxies when they have one.
     pub vertices: [usize; 2],
+    /// Vertices of the input shapes A and B, which the job holds throughout; where one is
+    /// larger than [`Job::vertices`], the shape is replaced by its proxy.
+    pub inputs: [usize; 2],
     /// Eigenpairs computed per shape.
     pub eigenpairs: usize,
     /// Full-resolution conversions of a functional map to a vertex map (each `n_a n_b k`
@@ -120,6 +130,54 @@ const EIGEN_SECONDS: f64 = 1e-7;
 /// "Address space").
 const ADDRESS_SPACE_PER_THREAD: u64 = 40 << 20;
 
+/// Bytes per vertex of an input shape held while the job runs on its proxy: the positions
+/// (24), about two triangles (24), the active and representative indices (8), and where
+/// every vertex lies on the proxy (40). Counted, not fitted.
+const INPUT_BYTES_PER_VERTEX: u64 = 96;
+
+/// Bytes per input vertex while a proxy is built (on top of the held input): single
+/// precision positions (12), the triangles' indices (24), meshoptimizer's tables for a
+/// piece of at most [`crate::shape::proxy::PIECE_TRIANGLES`] triangles (bounded, counted in
+/// [`PROXY_FIXED_BYTES`]), the order of the triangles (4) and the k-d tree of the
+/// proxy's answers brought back (48 per vertex of A, with the lifted map). Rounded up from
+/// the measured peaks on a 1.9M-vertex figure (docs/decisions.md, "Dense shapes: limits").
+const PROXY_BYTES_PER_VERTEX: u64 = 120;
+
+/// The proxy stage's memory that does not grow with the input: meshoptimizer's tables for
+/// pieces of [`crate::shape::proxy::PIECE_TRIANGLES`] triangles on every thread.
+const PROXY_FIXED_BYTES: u64 = 64 << 20;
+
+/// Seconds per input vertex of building a proxy and bringing the answers back, measured on
+/// a 1.9M-vertex figure on the 2-core reference machine (docs/decisions.md, "Dense
+/// shapes: limits").
+const PROXY_SECONDS_PER_VERTEX: f64 = 2e-6;
+
+/// Bytes per declared vertex while a file is read and repaired: the vertex as read (24),
+/// as kept (24 and 8 of indices), and the repairs' tables (weld targets, flags, the k-d
+/// tree of the weld). Fitted with [`READ_BYTES_PER_FACE`] to the peak of reading a
+/// 1.9M-vertex PLY (docs/decisions.md, "Dense shapes: limits").
+const READ_BYTES_PER_VERTEX: u64 = 160;
+
+/// Bytes per declared face while a file is read and repaired: the polygon as read (its own
+/// allocation: 24 and 32), its slice (16), its triangle (12) and the repairs' copies.
+const READ_BYTES_PER_FACE: u64 = 110;
+
+/// Seconds per byte of reading and repairing a shape file on the 2-core reference
+/// machine (docs/decisions.md, "Dense shapes: limits").
+const READ_SECONDS_PER_BYTE: f64 = 1e-7;
+
+/// Peak bytes of reading and repairing a file of this size (its bytes included).
+pub fn reading_bytes(size: &DeclaredSize) -> u64 {
+    size.bytes
+        + size.vertices as u64 * READ_BYTES_PER_VERTEX
+        + size.faces as u64 * READ_BYTES_PER_FACE
+}
+
+/// Seconds of reading and repairing a file of this size.
+pub fn reading_seconds(size: &DeclaredSize) -> f64 {
+    size.bytes as f64 * READ_SECONDS_PER_BYTE
+}
+
 /// The job's estimated peak memory and time.
 pub fn estimate(job: &Job) -> Estimate {
     let [n_a, n_b] = job.vertices.map(|n| n as u64);
@@ -147,7 +205,10 @@ pub fn estimate(job: &Job) -> Estimate {
     } else {
         0
     };
-    let bytes = BASE_BYTES + kept + eigensolve.max(conversion);
+    // Input shapes replaced by proxies are held at full size, and a proxy's construction
+    // comes before the working shapes' own memory.
+    let (inputs, proxy_stage, proxy_seconds) = proxied_inputs(job);
+    let bytes = BASE_BYTES + inputs + (kept + eigensolve.max(conversion)).max(proxy_stage);
     let doublings = |n: u64| (n.max(2) as f64).log2();
     let eigen_seconds = [n_a, n_b]
         .map(|n| EIGEN_SECONDS * (n * k) as f64 * doublings(n))
@@ -157,8 +218,25 @@ pub fn estimate(job: &Job) -> Estimate {
     let conversion_seconds = products / (CONVERSION_PRODUCTS_PER_SECOND * job.threads as f64);
     Estimate {
         bytes,
-        seconds: eigen_seconds + conversion_seconds,
+        seconds: eigen_seconds + conversion_seconds + proxy_seconds,
     }
+}
+
+/// What the input shapes that get a proxy add to a job: the held inputs' bytes, the proxy
+/// stage's bytes and its seconds.
+fn proxied_inputs(job: &Job) -> (u64, u64, f64) {
+    let proxied: Vec<u64> = (0..2)
+        .filter(|&i| job.inputs[i] > job.vertices[i])
+        .map(|i| job.inputs[i] as u64)
+        .collect();
+    if proxied.is_empty() {
+        return (0, 0, 0.0);
+    }
+    let held = proxied.iter().sum::<u64>() * INPUT_BYTES_PER_VERTEX;
+    let largest = proxied.iter().copied().max().unwrap_or(0);
+    let stage = PROXY_FIXED_BYTES + largest * PROXY_BYTES_PER_VERTEX;
+    let seconds = proxied.iter().sum::<u64>() as f64 * PROXY_SECONDS_PER_VERTEX;
+    (held, stage, seconds)
 }
 
 impl Budget {
@@ -174,8 +252,28 @@ impl Budget {
     /// Refuses a job whose estimate exceeds the memory ceiling or the time limit with
     /// [`Error::ResourceLimit`], naming the option and what to do.
     pub fn check(&self, job: &Job) -> Result<Estimate> {
-        let estimate = estimate(job);
-        let [n_a, n_b] = job.vertices;
+        self.check_estimate(job, estimate(job))
+    }
+
+    /// [`Budget::check`] for a job that first reads its two shape files, from what the files
+    /// declare ([`crate::shape::io::declared_size`]; `job` on those counts): the peak of
+    /// reading A, of holding A while reading B, or of the job.
+    pub fn check_with_reading(&self, job: &Job, files: [&DeclaredSize; 2]) -> Result<Estimate> {
+        let [a, b] = files;
+        let work = estimate(job);
+        let held_a = a.vertices as u64 * INPUT_BYTES_PER_VERTEX;
+        let estimate = Estimate {
+            bytes: work
+                .bytes
+                .max(BASE_BYTES + reading_bytes(a))
+                .max(BASE_BYTES + held_a + reading_bytes(b)),
+            seconds: work.seconds + reading_seconds(a) + reading_seconds(b),
+        };
+        self.check_estimate(job, estimate)
+    }
+
+    fn check_estimate(&self, job: &Job, estimate: Estimate) -> Result<Estimate> {
+        let [n_a, n_b] = job.inputs;
         let pair = if n_a == n_b {
             format!("{n_a}-vertex shapes")
         } else {
@@ -244,9 +342,10 @@ impl Budget {
         if self.time_limit_s <= 0.0 {
             return work(progress);
         }
+        let started = self.started.unwrap_or_else(Instant::now);
         let mut watched = Deadline {
             inner: progress,
-            deadline: Instant::now() + Duration::from_secs_f64(self.time_limit_s),
+            deadline: started + Duration::from_secs_f64(self.time_limit_s),
             passed_in: None,
         };
         let result = work(&mut watched);
@@ -286,6 +385,7 @@ impl Progress for Deadline<'_> {
 pub fn regions_job(vertices: [usize; 2], eigen: &EigenParams, verify: bool) -> Job {
     Job {
         vertices,
+        inputs: vertices,
         eigenpairs: eigen.n_eigenpairs,
         conversions: if verify { 3 } else { 0 },
         conversion_size: eigen.n_eigenpairs,

@@ -71,8 +71,12 @@ impl Multiresolution {
 
     /// The vertices `shape` is computed on: its proxy's size, or its own.
     pub fn working_size(&self, shape: &Shape) -> usize {
-        let n = shape.active_vertices().len();
-        if self.applies_to(shape) {
+        self.working_size_of(shape.active_vertices().len())
+    }
+
+    /// The vertices a shape of `n` active vertices is computed on.
+    pub fn working_size_of(&self, n: usize) -> usize {
+        if self.above != 0 && n > self.above {
             n.min(self.proxy_vertices)
         } else {
             n
@@ -99,7 +103,11 @@ impl Multiresolution {
         polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
             let build = |shape: &Shape| -> Result<Option<Proxy>> {
                 cancel.check()?;
-                self.proxy(shape)
+                if self.applies_to(shape) {
+                    Proxy::build_cancellable(shape, self.proxy_vertices, cancel).map(Some)
+                } else {
+                    Ok(None)
+                }
             };
             let proxy_a = build(a).map_err(|e| e.in_shape('A'))?;
             cancel.set_fraction(0.5);

@@ -14,6 +14,7 @@ use crate::pipeline::multiresolution::{lift_map, lift_regions, working};
 use crate::pipeline::pointwise::{basis_params, regions_and_map};
 use crate::pipeline::Params;
 use crate::progress::Progress;
+use crate::shape::io::declared_size;
 use crate::shape::proxy::Proxy;
 use crate::shape::Shape;
 use crate::spectral::eigen::{check_max_vertices, EigenParams, Eigenbasis, ShapeBasis};
@@ -94,12 +95,33 @@ impl PairJob<'_> {
     /// regions' eigensolves and the full-resolution conversions of maps (up to three when
     /// the hypotheses are verified: the answer and a close call's rival).
     pub fn budget_job(&self, [a, b]: [&Shape; 2]) -> Job {
-        let sizes = [a, b].map(|s| self.params.multiresolution.working_size(s));
+        self.budget_job_of_sizes([a, b].map(|s| s.active_vertices().len()))
+    }
+
+    /// Refuses, before anything is read, a job on these two shape files that the budget
+    /// cannot hold ([`crate::pipeline::budget::Budget::check_with_reading`], from the counts
+    /// the files declare).
+    pub fn check_files(&self, [a, b]: [&std::path::Path; 2]) -> Result<Estimate> {
+        let size_a = declared_size(a).map_err(|e| e.in_shape('A'))?;
+        let size_b = declared_size(b).map_err(|e| e.in_shape('B'))?;
+        let job = self.budget_job_of_sizes([size_a.vertices, size_b.vertices]);
+        self.params
+            .budget
+            .check_with_reading(&job, [&size_a, &size_b])
+    }
+
+    /// [`PairJob::budget_job`] on shapes of `inputs` active vertices (or an upper bound, such
+    /// as the counts a file declares).
+    pub fn budget_job_of_sizes(&self, inputs: [usize; 2]) -> Job {
+        let sizes = inputs.map(|n| self.params.multiresolution.working_size_of(n));
         let params = self.params;
         match self.map {
             None => {
                 let verify = params.verify_hypotheses && !params.skip_one_to_one;
-                regions_job(sizes, &params.eigen, verify)
+                Job {
+                    inputs,
+                    ..regions_job(sizes, &params.eigen, verify)
+                }
             }
             Some(map) => {
                 let eigen = self.eigen_params();
@@ -110,6 +132,7 @@ impl PairJob<'_> {
                 Job {
                     conversions: if params.verify_hypotheses { 3 } else { 1 },
                     conversion_size: size.min(eigen.n_eigenpairs),
+                    inputs,
                     ..regions_job(sizes, &eigen, false)
                 }
             }

@@ -15,6 +15,7 @@ pub mod surface_point;
 
 use std::collections::HashMap;
 
+use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::io::RawShape;
 use crate::shape::neighbors::{symmetric_knn_graph, PointTree};
 pub use crate::shape::repair::Repairs;
@@ -228,7 +229,7 @@ impl Shape {
     /// see the module docs.
     pub fn mesh(vertices: Vec<[f64; 3]>, triangles: &[[u32; 3]]) -> Result<Shape> {
         let polygons: Vec<&[u32]> = triangles.iter().map(|t| t.as_slice()).collect();
-        Shape::build(vertices, &polygons, ShapeKind::Mesh, &Repairs::default())
+        Shape::mesh_with_slices(vertices, &polygons, &Repairs::default())
     }
 
     /// A mesh from polygons of any size (quads and n-gons are triangulated).
@@ -243,7 +244,16 @@ impl Shape {
         repairs: &Repairs,
     ) -> Result<Shape> {
         let polygons: Vec<&[u32]> = polygons.iter().map(|p| p.as_slice()).collect();
-        Shape::build(vertices, &polygons, ShapeKind::Mesh, repairs)
+        Shape::mesh_with_slices(vertices, &polygons, repairs)
+    }
+
+    fn mesh_with_slices(
+        vertices: Vec<[f64; 3]>,
+        polygons: &[&[u32]],
+        repairs: &Repairs,
+    ) -> Result<Shape> {
+        let cancel = Cancel::default();
+        Shape::build(vertices, polygons, ShapeKind::Mesh, repairs, &cancel)
     }
 
     /// A point cloud (no faces), with the default [`Repairs`].
@@ -253,7 +263,13 @@ impl Shape {
 
     /// A point cloud with the given repairs.
     pub fn point_cloud_with(vertices: Vec<[f64; 3]>, repairs: &Repairs) -> Result<Shape> {
-        Shape::build(vertices, &[], ShapeKind::PointCloud, repairs)
+        Shape::build(
+            vertices,
+            &[],
+            ShapeKind::PointCloud,
+            repairs,
+            &Cancel::default(),
+        )
     }
 
     /// A shape from a file's contents: a point cloud when it has no faces or when `read_as`
@@ -264,10 +280,22 @@ impl Shape {
 
     /// [`Shape::from_raw`] with the given repairs.
     pub fn from_raw_with(raw: RawShape, read_as: ReadAs, repairs: &Repairs) -> Result<Shape> {
+        Shape::from_raw_cancellable(raw, read_as, repairs, &Cancel::default())
+    }
+
+    /// [`Shape::from_raw_with`], stopping with [`Error::Cancelled`] between its steps once
+    /// `cancel` is set.
+    fn from_raw_cancellable(
+        raw: RawShape,
+        read_as: ReadAs,
+        repairs: &Repairs,
+        cancel: &Cancel,
+    ) -> Result<Shape> {
         if read_as == ReadAs::PointCloud || raw.polygons.is_empty() {
-            Shape::point_cloud_with(raw.vertices, repairs)
+            Shape::build(raw.vertices, &[], ShapeKind::PointCloud, repairs, cancel)
         } else {
-            Shape::mesh_with(raw.vertices, &raw.polygons, repairs)
+            let polygons: Vec<&[u32]> = raw.polygons.iter().map(|p| p.as_slice()).collect();
+            Shape::build(raw.vertices, &polygons, ShapeKind::Mesh, repairs, cancel)
         }
     }
 
@@ -281,11 +309,30 @@ impl Shape {
         Shape::from_raw_with(crate::shape::io::read_shape(path)?, read_as, repairs)
     }
 
+    /// [`Shape::read_with`] reporting to `progress` as [`Stage::Reading`] (the parse from 0
+    /// to 0.5, the repairs from 0.5 to 1) every [`crate::progress::POLL_INTERVAL`]; a
+    /// cancel stops reading within a few thousand lines or elements and the repairs between
+    /// their steps, with [`Error::Cancelled`].
+    pub fn read_watched(
+        path: &std::path::Path,
+        read_as: ReadAs,
+        repairs: &Repairs,
+        progress: &mut dyn Progress,
+    ) -> Result<Shape> {
+        let raw = polled(progress, Stage::Reading, (0.0, 0.5), |cancel| {
+            crate::shape::io::read_shape_cancellable(path, cancel)
+        })?;
+        polled(progress, Stage::Reading, (0.5, 1.0), |cancel| {
+            Shape::from_raw_cancellable(raw, read_as, repairs, cancel)
+        })
+    }
+
     fn build(
         vertices: Vec<[f64; 3]>,
         polygons: &[&[u32]],
         kind: ShapeKind,
         repairs: &Repairs,
+        cancel: &Cancel,
     ) -> Result<Shape> {
         for (i, v) in vertices.iter().enumerate() {
             if let Some(&value) = v.iter().find(|c| !c.is_finite()) {
@@ -305,9 +352,14 @@ impl Shape {
             active,
             welded_to,
         } = match kind {
-            ShapeKind::Mesh => Shape::repaired_mesh(&vertices, polygons, repairs, &mut warnings)?,
-            ShapeKind::PointCloud => Shape::repaired_cloud(&vertices, repairs, &mut warnings),
+            ShapeKind::Mesh => {
+                Shape::repaired_mesh(&vertices, polygons, repairs, &mut warnings, cancel)?
+            }
+            ShapeKind::PointCloud => {
+                Shape::repaired_cloud(&vertices, repairs, &mut warnings, cancel)?
+            }
         };
+        cancel.check()?;
         if active.len() < MIN_VERTICES {
             return Err(Error::TooFewVertices {
                 received: active.len(),
@@ -315,6 +367,7 @@ impl Shape {
             });
         }
         let mut representative = representatives(&vertices, &active);
+        cancel.check()?;
         for (v, rep) in representative.iter_mut().enumerate() {
             let root = welded_to[v];
             if root as usize != v && representative_is_active(&active, root) {
@@ -345,6 +398,7 @@ impl Shape {
                         .warnings
                         .push(Warning::NeedleOrZeroAreaFaces { count: needles });
                 }
+                cancel.check()?;
                 shape.check_edges();
             }
             ShapeKind::PointCloud => {
@@ -356,6 +410,7 @@ impl Shape {
                 }
             }
         }
+        cancel.check()?;
         shape.n_pieces = shape.count_pieces();
         if shape.n_pieces > 1 {
             shape.warnings.push(Warning::DisconnectedPieces {
@@ -373,6 +428,7 @@ impl Shape {
         polygons: &[&[u32]],
         repairs: &Repairs,
         warnings: &mut Vec<Warning>,
+        cancel: &Cancel,
     ) -> Result<Repaired> {
         let n = vertices.len();
         // Indices are checked before anything looks at them.
@@ -396,6 +452,7 @@ impl Shape {
             }
             (0..n as u32).filter(|&v| used[v as usize]).collect()
         };
+        cancel.check()?;
         let referenced = used_by(&triangles);
         let mut dropped = vec![false; n];
         if repairs.outliers {
@@ -408,9 +465,12 @@ impl Shape {
                 warnings.push(Warning::FarVerticesDropped { count: far.len() });
             }
         }
+        cancel.check()?;
         let kept = used_by(&triangles);
         let size = repair::robust_size(vertices, &kept);
+        cancel.check()?;
         let welded_to = repair::weld(vertices, &kept, repairs.weld_tolerance * size);
+        cancel.check()?;
         let welded = kept.iter().filter(|&&v| welded_to[v as usize] != v).count();
         if welded > 0 {
             for t in &mut triangles {
@@ -424,7 +484,9 @@ impl Shape {
                 });
             }
         }
+        cancel.check()?;
         let keep = repair::keep_large_pieces(vertices, &triangles, repairs.debris_fraction);
+        cancel.check()?;
         if keep.iter().any(|&k| !k) {
             let before = used_by(&triangles).len();
             let mut pieces = DisjointSets::new(n);
@@ -469,7 +531,8 @@ impl Shape {
         vertices: &[[f64; 3]],
         repairs: &Repairs,
         warnings: &mut Vec<Warning>,
-    ) -> Repaired {
+        cancel: &Cancel,
+    ) -> Result<Repaired> {
         let all: Vec<u32> = (0..vertices.len() as u32).collect();
         let mut active = all.clone();
         if repairs.outliers {
@@ -483,8 +546,10 @@ impl Shape {
                 warnings.push(Warning::FarVerticesDropped { count: far.len() });
             }
         }
+        cancel.check()?;
         let size = repair::robust_size(vertices, &active);
         let welded_to = repair::weld(vertices, &active, repairs.weld_tolerance * size);
+        cancel.check()?;
         let before = active.len();
         active.retain(|&v| welded_to[v as usize] == v);
         if active.len() < before {
@@ -501,6 +566,7 @@ impl Shape {
                 });
             }
         }
+        cancel.check()?;
         if active.len() >= MIN_VERTICES {
             let before = active.len();
             let (kept, pieces) =
@@ -513,11 +579,11 @@ impl Shape {
                 active = kept;
             }
         }
-        Repaired {
+        Ok(Repaired {
             triangles: Vec::new(),
             active,
             welded_to,
-        }
+        })
     }
 
     /// Vertex positions in the caller's order and units.

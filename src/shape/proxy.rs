@@ -12,6 +12,7 @@
 
 use rayon::prelude::*;
 
+use crate::progress::Cancel;
 use crate::shape::neighbors::PointTree;
 use crate::shape::surface_point::{
     closest_on_triangle, heaviest_first, inverse_distance, SurfacePoint,
@@ -39,6 +40,17 @@ impl Proxy {
     /// A proxy of `shape` with about `target_vertices` vertices (at least 3 fewer than the
     /// shape's active vertices, else [`crate::Error::InvalidParameter`]).
     pub fn build(shape: &Shape, target_vertices: usize) -> Result<Proxy> {
+        Proxy::build_cancellable(shape, target_vertices, &Cancel::default())
+    }
+
+    /// [`Proxy::build`], stopping with [`crate::Error::Cancelled`] soon after `cancel` is set:
+    /// between the pieces of a dense mesh's simplification ([`PIECE_TRIANGLES`]) and between
+    /// blocks of [`LOCATE_BLOCK`] input vertices while locating them.
+    pub fn build_cancellable(
+        shape: &Shape,
+        target_vertices: usize,
+        cancel: &Cancel,
+    ) -> Result<Proxy> {
         let active = shape.active_vertices();
         if target_vertices < 64 || target_vertices >= active.len() {
             return Err(crate::Error::InvalidParameter {
@@ -56,7 +68,13 @@ impl Proxy {
             .collect();
         let (kept, triangles) = match shape.kind() {
             ShapeKind::Mesh => {
-                let triangles = simplified_triangles(shape, &positions, target_vertices);
+                let triangles = simplified_triangles(
+                    shape,
+                    &positions,
+                    target_vertices,
+                    PIECE_TRIANGLES,
+                    cancel,
+                )?;
                 let mut kept: Vec<u32> = triangles.iter().flatten().copied().collect();
                 kept.sort_unstable();
                 kept.dedup();
@@ -89,7 +107,8 @@ impl Proxy {
             }
             ShapeKind::PointCloud => Shape::point_cloud_with(vertices, &Repairs::default())?,
         };
-        let location = locate(shape, &proxy_shape);
+        cancel.check()?;
+        let location = locate(shape, &proxy_shape, cancel)?;
         Ok(Proxy {
             shape: proxy_shape,
             input_vertex: kept,
@@ -108,16 +127,44 @@ impl Proxy {
     }
 }
 
+/// Triangles per piece of a dense mesh's first simplification pass: meshoptimizer's
+/// simplification is one call that cannot be interrupted, so a piece bounds the wait for a
+/// cancel: 0.62 s measured on 2 cores under a load of 13 (docs/decisions.md, "Dense shapes:
+/// limits").
+pub const PIECE_TRIANGLES: usize = 100_000;
+
+/// What the first pass keeps of a dense mesh: this many times the proxy's triangles, so that
+/// the last pass (one call on the whole surface) starts from a mesh of a bounded size.
+const FIRST_PASS_MARGIN: usize = 4;
+
 /// The triangles meshoptimizer keeps for about `target_vertices` vertices, in input indices.
+/// A mesh of more than `2 * FIRST_PASS_MARGIN` times the target's triangles and more than
+/// `piece` triangles is first simplified piece by piece ([`simplified_in_pieces`]).
 fn simplified_triangles(
     shape: &Shape,
     positions: &[[f32; 3]],
     target_vertices: usize,
-) -> Vec<[u32; 3]> {
-    let indices: Vec<u32> = shape.triangles().iter().flatten().copied().collect();
-    // A closed surface has about two triangles per vertex. The error bound is left open
-    // (1.0 of the mesh's extent): the count decides.
+    piece: usize,
+    cancel: &Cancel,
+) -> Result<Vec<[u32; 3]>> {
+    // A closed surface has about two triangles per vertex.
     let target_indices = 3 * 2 * target_vertices;
+    let triangles = shape.triangles();
+    let indices: Vec<u32> = if triangles.len() > piece
+        && 3 * triangles.len() > 2 * FIRST_PASS_MARGIN * target_indices
+    {
+        simplified_in_pieces(
+            triangles,
+            positions,
+            FIRST_PASS_MARGIN * target_indices,
+            piece,
+            cancel,
+        )?
+    } else {
+        triangles.iter().flatten().copied().collect()
+    };
+    cancel.check()?;
+    // The error bound is left open (1.0 of the mesh's extent): the count decides.
     let kept = meshopt::simplify_decoder(
         &indices,
         positions,
@@ -126,12 +173,79 @@ fn simplified_triangles(
         meshopt::SimplifyOptions::Regularize,
         None,
     );
-    kept.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+    Ok(kept.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
 }
+
+/// A dense mesh's first simplification pass, to about `target_indices` indices in all: the
+/// triangles in slabs of `piece` triangles along the bounding box's longest axis (by
+/// centroid), each slab simplified on its own with its border locked (so the slabs still
+/// meet), `cancel` looked at before each slab. The slabs run in parallel; their order, and
+/// so the result, does not depend on the threads.
+fn simplified_in_pieces(
+    triangles: &[[u32; 3]],
+    positions: &[[f32; 3]],
+    target_indices: usize,
+    piece: usize,
+    cancel: &Cancel,
+) -> Result<Vec<u32>> {
+    let centroid =
+        |t: &[u32; 3], c: usize| t.iter().map(|&v| positions[v as usize][c]).sum::<f32>();
+    let extent = |c: usize| {
+        let (lo, hi) = triangles.iter().fold((f32::MAX, f32::MIN), |(lo, hi), t| {
+            let x = centroid(t, c);
+            (lo.min(x), hi.max(x))
+        });
+        hi - lo
+    };
+    let axis = (0..3)
+        .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
+        .unwrap_or(0);
+    let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+    order.par_sort_unstable_by(|&a, &b| {
+        centroid(&triangles[a as usize], axis)
+            .total_cmp(&centroid(&triangles[b as usize], axis))
+            .then(a.cmp(&b))
+    });
+    let keep = target_indices as f64 / (3 * triangles.len()) as f64;
+    let slabs: Vec<Result<Vec<u32>>> = order
+        .par_chunks(piece)
+        .map(|slab| {
+            cancel.check()?;
+            // The slab's vertices renumbered from 0, for a call whose cost is the slab's.
+            let mut own: Vec<u32> = slab.iter().flat_map(|&f| triangles[f as usize]).collect();
+            own.sort_unstable();
+            own.dedup();
+            let local = |v: u32| own.binary_search(&v).unwrap_or_default() as u32;
+            let indices: Vec<u32> = slab
+                .iter()
+                .flat_map(|&f| triangles[f as usize].map(local))
+                .collect();
+            let points: Vec<[f32; 3]> = own.iter().map(|&v| positions[v as usize]).collect();
+            let target = ((indices.len() as f64 * keep) as usize / 3 * 3).max(3);
+            let kept = meshopt::simplify_decoder(
+                &indices,
+                &points,
+                target,
+                1.0,
+                meshopt::SimplifyOptions::LockBorder | meshopt::SimplifyOptions::Regularize,
+                None,
+            );
+            Ok(kept.into_iter().map(|v| own[v as usize]).collect())
+        })
+        .collect();
+    let mut indices = Vec::with_capacity(2 * target_indices);
+    for slab in slabs {
+        indices.extend(slab?);
+    }
+    Ok(indices)
+}
+
+/// Input vertices located per block between two looks at the cancel flag.
+const LOCATE_BLOCK: usize = 16_384;
 
 /// Where every input vertex of `shape` lies on `proxy` (an inactive vertex where its
 /// representative lies).
-fn locate(shape: &Shape, proxy: &Shape) -> Vec<SurfacePoint> {
+fn locate(shape: &Shape, proxy: &Shape, cancel: &Cancel) -> Result<Vec<SurfacePoint>> {
     let proxy_active = proxy.active_vertices();
     let active_points: Vec<[f64; 3]> = proxy_active
         .iter()
@@ -164,22 +278,22 @@ fn locate(shape: &Shape, proxy: &Shape) -> Vec<SurfacePoint> {
         heaviest_first(proxy.triangles()[f as usize], bary)
     };
     let representative = shape.representative();
-    let own: Vec<SurfacePoint> = shape
-        .vertices()
-        .par_iter()
-        .enumerate()
-        .map(|(v, p)| {
+    let n = shape.n_vertices();
+    let mut own: Vec<SurfacePoint> = Vec::with_capacity(n);
+    for start in (0..n).step_by(LOCATE_BLOCK) {
+        cancel.check()?;
+        cancel.set_fraction(start as f32 / n as f32);
+        let end = (start + LOCATE_BLOCK).min(n);
+        own.par_extend((start..end).into_par_iter().map(|v| {
             if representative[v] as usize == v {
-                at(p)
+                at(&shape.vertices()[v])
             } else {
                 SurfacePoint {
                     vertices: [0; 3],
                     weights: [1.0, 0.0, 0.0],
                 }
             }
-        })
-        .collect();
-    (0..shape.n_vertices())
-        .map(|v| own[representative[v] as usize])
-        .collect()
+        }));
+    }
+    Ok((0..n).map(|v| own[representative[v] as usize]).collect())
 }

@@ -7,6 +7,7 @@
 mod collection;
 mod common;
 mod correspondence;
+mod dense_limits;
 mod determinism;
 mod fuzz_regressions;
 mod header;

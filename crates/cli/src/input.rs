@@ -4,26 +4,48 @@
 use crate::output::errln;
 use std::path::{Path, PathBuf};
 
-use shapecorr::{Error, ReadAs, Repairs, Shape};
+use shapecorr::pipeline::budget::Budget;
+use shapecorr::{Error, Progress, ReadAs, Repairs, Shape};
 
 use crate::commands::naming_files;
 
 /// Reads `path` as a shape (a point cloud when `points`), with the default repairs unless
 /// `no_repair`.
 pub fn read_shape(path: &Path, points: bool, no_repair: bool) -> Result<Shape, Error> {
+    read_shape_watched(path, points, no_repair, &mut shapecorr::NoProgress)
+}
+
+/// [`read_shape`], reporting to `progress`, which may stop it ([`Shape::read_watched`]).
+fn read_shape_watched(
+    path: &Path,
+    points: bool,
+    no_repair: bool,
+    progress: &mut dyn Progress,
+) -> Result<Shape, Error> {
     let repairs = if no_repair {
         Repairs::none()
     } else {
         Repairs::default()
     };
-    Shape::read_with(path, ReadAs::point_cloud_when(points), &repairs)
+    Shape::read_watched(path, ReadAs::point_cloud_when(points), &repairs, progress)
 }
 
 /// Reads shape `side` (`'A'` or `'B'`) of a pair as [`read_shape`]; an error names the side
 /// and the file, and every repair made is printed on stderr as `shapecorr: repaired SIDE
 /// (PATH): ...`.
 pub fn read_input(side: char, path: &Path, points: bool, no_repair: bool) -> Result<Shape, Error> {
-    let shape = read_shape(path, points, no_repair).map_err(|e| match e {
+    read_input_watched(side, path, points, no_repair, &mut shapecorr::NoProgress)
+}
+
+/// [`read_input`], reporting to `progress`, which may stop it.
+fn read_input_watched(
+    side: char,
+    path: &Path,
+    points: bool,
+    no_repair: bool,
+    progress: &mut dyn Progress,
+) -> Result<Shape, Error> {
+    let shape = read_shape_watched(path, points, no_repair, progress).map_err(|e| match e {
         Error::File { path, reason } => Error::File {
             path,
             reason: format!("shape {side}: {reason}"),
@@ -59,6 +81,26 @@ impl ShapePairArgs {
             read_input('A', &self.a, self.points, self.no_repair)?,
             read_input('B', &self.b, self.points, self.no_repair)?,
         ))
+    }
+
+    /// Shapes A and B, read as part of a job under `budget`: its time limit counts from now
+    /// (`budget.started` is set), so reading is stopped when it runs past it, and the job's
+    /// estimate, from the counts the files declare, is checked against the memory ceiling
+    /// before anything is read (`job`).
+    pub fn read_in_budget(
+        &self,
+        budget: &mut Budget,
+        check: impl FnOnce([&Path; 2]) -> Result<(), Error>,
+        progress: &mut dyn Progress,
+    ) -> Result<(Shape, Shape), Error> {
+        budget.started = Some(std::time::Instant::now());
+        check([&self.a, &self.b]).map_err(|e| self.naming(e))?;
+        budget.run(progress, |progress| {
+            Ok((
+                read_input_watched('A', &self.a, self.points, self.no_repair, progress)?,
+                read_input_watched('B', &self.b, self.points, self.no_repair, progress)?,
+            ))
+        })
     }
 
     /// An error about shape A or B as one naming its file ([`naming_files`]).

@@ -31,6 +31,7 @@ use std::borrow::Cow;
 use std::path::Path;
 
 use crate::error::{Error, Result};
+use crate::progress::Cancel;
 
 mod obj;
 mod off;
@@ -93,20 +94,47 @@ impl Format {
 
     /// Parses `bytes` in this format; `name` is only used in error messages.
     pub fn parse(self, bytes: &[u8], name: &Path) -> Result<RawShape> {
-        match self {
-            Format::Off => parse_off(bytes, name),
-            Format::Obj => parse_obj(bytes, name),
-            Format::Ply => parse_ply(bytes, name),
-            Format::Xyz => parse_xyz(bytes, name),
-        }
+        self.parse_cancellable(bytes, name, &Cancel::default())
     }
+
+    /// [`Format::parse`], stopping with [`Error::Cancelled`] within [`CHECK_EVERY`] lines or
+    /// elements of a cancel, and publishing the fraction of the bytes parsed.
+    pub(crate) fn parse_cancellable(
+        self,
+        bytes: &[u8],
+        name: &Path,
+        cancel: &Cancel,
+    ) -> Result<RawShape> {
+        let parsed = match self {
+            Format::Off => off::off(bytes, cancel),
+            Format::Obj => obj::obj(bytes, cancel),
+            Format::Ply => ply::ply(bytes, cancel),
+            Format::Xyz => xyz::xyz(bytes, cancel),
+        };
+        // A cancel ends the parse early, as if the file ended there: say why.
+        cancel.check()?;
+        parsed.map_err(|reason| Error::file(name, reason))
+    }
+}
+
+/// Lines or elements a reader parses between two looks at its cancel flag: about 1 ms of
+/// parsing (1-2 M lines a second here).
+pub(crate) const CHECK_EVERY: usize = 4096;
+
+/// Reads a shape file as [`read_shape`], stopping with [`Error::Cancelled`] soon after
+/// `cancel` is set (between [`READ_CHUNK`] bytes while reading, every [`CHECK_EVERY`]
+/// lines or elements while parsing); the fraction published runs from 0 to 1 over the
+/// parse.
+pub(crate) fn read_shape_cancellable(path: &Path, cancel: &Cancel) -> Result<RawShape> {
+    let format = Format::from_path(path)?;
+    let bytes = read_bytes_cancellable(path, cancel)?;
+    format.parse_cancellable(&bytes, path, cancel)
 }
 
 /// Reads a shape file, choosing the reader from the extension (case-insensitive):
 /// `.off`, `.obj`, `.ply`, `.xyz`, `.pts`.
 pub fn read_shape(path: &Path) -> Result<RawShape> {
-    let format = Format::from_path(path)?;
-    format.parse(&read_bytes(path)?, path)
+    read_shape_cancellable(path, &Cancel::default())
 }
 
 /// Parses shape bytes, choosing the reader from the extension of `name`.
@@ -143,7 +171,125 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 /// also through a symbolic link), sockets and directories are refused before the file is
 /// opened, so reading never blocks or runs unbounded.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    read_bytes_cancellable(path, &Cancel::default())
+}
+
+/// Bytes read between two looks at the cancel flag: a few milliseconds from the page cache,
+/// about 0.1 s from a slow disk (80 MB/s).
+const READ_CHUNK: usize = 8 << 20;
+
+/// [`read_bytes`], checking `cancel` between chunks of [`READ_CHUNK`] bytes.
+fn read_bytes_cancellable(path: &Path, cancel: &Cancel) -> Result<Vec<u8>> {
     use std::io::Read;
+    let cannot = |e: std::io::Error| Error::file(path, format!("cannot read the file: {e}"));
+    let size = regular_file_size(path)?;
+    let mut bytes = Vec::with_capacity(size as usize);
+    let mut file = std::fs::File::open(path)
+        .map_err(cannot)?
+        .take(MAX_FILE_BYTES + 1);
+    loop {
+        cancel.check()?;
+        let read = (&mut file)
+            .take(READ_CHUNK as u64)
+            .read_to_end(&mut bytes)
+            .map_err(cannot)?;
+        if read == 0 {
+            break;
+        }
+    }
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large(path, bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// What a shape file holds, known before its body is read: its size and the vertices and
+/// faces it declares (PLY, OFF: from the header; OBJ, XYZ: by counting the lines that start
+/// with `v ` and `f `, or the lines, without parsing them). Counts are capped by what the
+/// file's bytes can hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DeclaredSize {
+    /// Bytes of the file.
+    pub bytes: u64,
+    /// Vertices declared.
+    pub vertices: usize,
+    /// Faces declared.
+    pub faces: usize,
+}
+
+/// The [`DeclaredSize`] of a shape file, read cheaply: the header, or one pass counting
+/// lines through a small buffer. The file gets the readers' checks (a regular file of at
+/// most [`MAX_FILE_BYTES`]); a header this cannot make sense of gives counts of 0 (the
+/// reader then says what is wrong).
+pub fn declared_size(path: &Path) -> Result<DeclaredSize> {
+    use std::io::{BufRead, Read};
+    let format = Format::from_path(path)?;
+    let bytes = regular_file_size(path)?;
+    let cannot = |e: std::io::Error| Error::file(path, format!("cannot read the file: {e}"));
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let mut reader = std::io::BufReader::with_capacity(1 << 16, file);
+    let (mut vertices, mut faces) = (0usize, 0usize);
+    let count = |t: Option<&str>| t.and_then(|t| t.parse::<usize>().ok()).unwrap_or(0);
+    match format {
+        Format::Ply | Format::Off => {
+            let mut head = Vec::new();
+            reader
+                .by_ref()
+                .take(1 << 16)
+                .read_to_end(&mut head)
+                .map_err(cannot)?;
+            let text = String::from_utf8_lossy(&head);
+            let mut lines = text
+                .lines()
+                .map(|l| l.split('#').next().unwrap_or("").trim());
+            if format == Format::Ply {
+                for line in lines.by_ref().take_while(|l| *l != "end_header") {
+                    let mut t = line.split_ascii_whitespace();
+                    match (t.next(), t.next()) {
+                        (Some("element"), Some("vertex")) => vertices = count(t.next()),
+                        (Some("element"), Some("face")) => faces = count(t.next()),
+                        _ => {}
+                    }
+                }
+            } else {
+                let mut data = lines.filter(|l| !l.is_empty());
+                let keyword = data.next().unwrap_or("");
+                let mut t: Vec<&str> = keyword.split_ascii_whitespace().skip(1).collect();
+                if t.is_empty() {
+                    t = data.next().unwrap_or("").split_ascii_whitespace().collect();
+                }
+                vertices = count(t.first().copied());
+                faces = count(t.get(1).copied());
+            }
+        }
+        Format::Obj | Format::Xyz => {
+            let mut line = Vec::new();
+            loop {
+                line.clear();
+                if reader.read_until(b'\n', &mut line).map_err(cannot)? == 0 {
+                    break;
+                }
+                let l = line.trim_ascii_start();
+                match format {
+                    Format::Obj if l.starts_with(b"v ") || l.starts_with(b"v\t") => vertices += 1,
+                    Format::Obj if l.starts_with(b"f ") || l.starts_with(b"f\t") => faces += 1,
+                    Format::Xyz if !l.is_empty() && !l.starts_with(b"#") => vertices += 1,
+                    _ => {}
+                }
+            }
+        }
+    }
+    // A vertex takes at least 3 bytes (binary `char` coordinates), a face 4.
+    let room = usize::try_from(bytes).unwrap_or(usize::MAX);
+    Ok(DeclaredSize {
+        bytes,
+        vertices: capped(vertices, room, 3),
+        faces: capped(faces, room, 4),
+    })
+}
+
+/// The size of a regular file of at most [`MAX_FILE_BYTES`] (the checks of [`read_bytes`]).
+fn regular_file_size(path: &Path) -> Result<u64> {
     let cannot = |e: std::io::Error| Error::file(path, format!("cannot read the file: {e}"));
     let meta = std::fs::metadata(path).map_err(cannot)?;
     if !meta.is_file() {
@@ -157,28 +303,20 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
             format!("is {what}, not a regular file; shapecorr reads regular files only"),
         ));
     }
-    let too_large = |size: u64| {
-        Error::file(
-            path,
-            format!(
-                "the file has {size} bytes, more than the {MAX_FILE_BYTES} bytes (4 GiB) \
-                 shapecorr reads; simplify the shape"
-            ),
-        )
-    };
     if meta.len() > MAX_FILE_BYTES {
-        return Err(too_large(meta.len()));
+        return Err(too_large(path, meta.len()));
     }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    std::fs::File::open(path)
-        .map_err(cannot)?
-        .take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
+    Ok(meta.len())
+}
+
+fn too_large(path: &Path, size: u64) -> Error {
+    Error::file(
+        path,
+        format!(
+            "the file has {size} bytes, more than the {MAX_FILE_BYTES} bytes (4 GiB) \
+             shapecorr reads; simplify the shape"
+        ),
+    )
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -192,9 +330,20 @@ fn text_of(bytes: &[u8]) -> Cow<'_, str> {
 }
 
 /// The lines that hold data: `(1-based line number, content)`, with `#` comments removed,
-/// surrounding white space trimmed and empty lines skipped.
-fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.split('\n').enumerate().filter_map(|(i, line)| {
+/// surrounding white space trimmed and empty lines skipped. Once `cancel` is set the lines
+/// end (within [`CHECK_EVERY`] lines), and the fraction of the text gone through is
+/// published as they go.
+fn data_lines<'a>(text: &'a str, cancel: &'a Cancel) -> impl Iterator<Item = (usize, &'a str)> {
+    let total = text.len().max(1) as f32;
+    let start = text.as_ptr() as usize;
+    let watched = text.split('\n').enumerate().take_while(move |(i, line)| {
+        if i % CHECK_EVERY != 0 {
+            return true;
+        }
+        cancel.set_fraction((line.as_ptr() as usize - start) as f32 / total);
+        cancel.check().is_ok()
+    });
+    watched.filter_map(|(i, line)| {
         let line = line
             .split('#')
             .next()

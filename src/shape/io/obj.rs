@@ -4,6 +4,7 @@ use std::path::Path;
 
 use super::{data_lines, is_integer, parse_xyz_tokens, shown, text_of, RawShape};
 use crate::error::{Error, Result};
+use crate::progress::Cancel;
 
 /// OBJ statements that carry nothing a shape needs; they are skipped. Any other statement is
 /// an error (it usually means the file is not an OBJ file).
@@ -54,13 +55,13 @@ const OBJ_IGNORED: &[&str] = &[
 /// cloud. Texture coordinates, normals, lines, points, groups and materials are ignored; an
 /// unknown statement is an error. Line continuations (`\`) are not supported.
 pub fn parse_obj(bytes: &[u8], name: &Path) -> Result<RawShape> {
-    obj(bytes).map_err(|reason| Error::file(name, reason))
+    obj(bytes, &Cancel::default()).map_err(|reason| Error::file(name, reason))
 }
 
-fn obj(bytes: &[u8]) -> Result<RawShape, String> {
+pub(super) fn obj(bytes: &[u8], cancel: &Cancel) -> Result<RawShape, String> {
     let text = text_of(bytes);
     let mut shape = RawShape::default();
-    for (line, content) in data_lines(&text) {
+    for (line, content) in data_lines(&text, cancel) {
         let mut tokens = content.split_ascii_whitespace();
         let keyword = tokens.next().unwrap_or_default();
         match keyword {

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use super::{capped, data_lines, parse_index, parse_xyz_tokens, shown, text_of, RawShape};
 use crate::error::{Error, Result};
+use crate::progress::Cancel;
 
 /// Parses ASCII OFF: a keyword line (`OFF`, `COFF`, `NOFF`, `CNOFF`, `STOFF`, ...), the counts
 /// `n_vertices n_faces [n_edges]` (on the keyword line or the next data line), one vertex per
@@ -12,12 +13,12 @@ use crate::error::{Error, Result};
 /// (ignored). `#` starts a comment. The numbers of vertices and faces must match the header,
 /// and nothing but comments may follow the faces. Binary OFF is rejected.
 pub fn parse_off(bytes: &[u8], name: &Path) -> Result<RawShape> {
-    off(bytes).map_err(|reason| Error::file(name, reason))
+    off(bytes, &Cancel::default()).map_err(|reason| Error::file(name, reason))
 }
 
-fn off(bytes: &[u8]) -> Result<RawShape, String> {
+pub(super) fn off(bytes: &[u8], cancel: &Cancel) -> Result<RawShape, String> {
     let text = text_of(bytes);
-    let mut lines = data_lines(&text);
+    let mut lines = data_lines(&text, cancel);
     let Some((first, header)) = lines.next() else {
         return Err(if bytes.is_empty() {
             "empty file (expected an OFF header)".to_string()

@@ -7,8 +7,9 @@ use ply_rs_bw::ply::{
     ElementDef, Encoding, Header, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
 };
 
-use super::{capped, shown, RawShape};
+use super::{capped, shown, RawShape, CHECK_EVERY};
 use crate::error::{Error, Result};
+use crate::progress::Cancel;
 
 // ---------------------------------------------------------------------------------------------
 // PLY reading
@@ -20,7 +21,7 @@ use crate::error::{Error, Result};
 /// the header declares is an error, and so is data after the last element (it means the
 /// header does not describe the data), except trailing white space.
 pub fn parse_ply(bytes: &[u8], name: &Path) -> Result<RawShape> {
-    ply(bytes).map_err(|reason| Error::file(name, reason))
+    ply(bytes, &Cancel::default()).map_err(|reason| Error::file(name, reason))
 }
 
 /// Collapses `ply-rs-bw`'s multi-line messages onto one line.
@@ -54,7 +55,7 @@ fn ply_header_error(e: &ParseError, bytes: &[u8]) -> String {
     }
 }
 
-fn ply(bytes: &[u8]) -> Result<RawShape, String> {
+pub(super) fn ply(bytes: &[u8], cancel: &Cancel) -> Result<RawShape, String> {
     if bytes.is_empty() {
         return Err("empty file (expected a PLY header)".to_string());
     }
@@ -80,6 +81,8 @@ fn ply(bytes: &[u8]) -> Result<RawShape, String> {
         encoding: header.encoding,
         rest: body,
         line: first_body_line,
+        total: bytes.len(),
+        cancel,
     };
     let mut shape = RawShape::default();
     for def in header.elements.values() {
@@ -228,6 +231,10 @@ struct Body<'a> {
     rest: &'a [u8],
     /// 1-based line number of `rest`'s first line (ASCII only).
     line: usize,
+    /// Bytes of the whole file, for the fraction read.
+    total: usize,
+    /// Looked at every [`CHECK_EVERY`] elements; once set, reading stops.
+    cancel: &'a Cancel,
 }
 
 impl Body<'_> {
@@ -239,6 +246,14 @@ impl Body<'_> {
     ) -> Result<(), String> {
         let parser = Parser::<E>::new();
         for i in 0..def.count {
+            if i % CHECK_EVERY == 0 {
+                let read = self.total.saturating_sub(self.rest.len());
+                self.cancel
+                    .set_fraction(read as f32 / self.total.max(1) as f32);
+                if self.cancel.check().is_err() {
+                    return Err("cancelled".to_string());
+                }
+            }
             let element = match self.encoding {
                 Encoding::Ascii => self.ascii_element(def, i)?,
                 Encoding::BinaryLittleEndian | Encoding::BinaryBigEndian => {

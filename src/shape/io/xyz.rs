@@ -4,6 +4,7 @@ use std::path::Path;
 
 use super::{capped, data_lines, is_integer, parse_xyz_tokens, shown, text_of, RawShape};
 use crate::error::{Error, Result};
+use crate::progress::Cancel;
 
 /// Parses a point list (`.xyz`, `.pts`): one point per line, numbers separated by white space
 /// or commas; the first 3 are x y z and extra columns (normals, colours, ...) are ignored.
@@ -11,7 +12,7 @@ use crate::error::{Error, Result};
 /// integer is the point count (the common `.pts` convention) and must then match the number of
 /// points. A file without points is an error.
 pub fn parse_xyz(bytes: &[u8], name: &Path) -> Result<RawShape> {
-    xyz(bytes).map_err(|reason| Error::file(name, reason))
+    xyz(bytes, &Cancel::default()).map_err(|reason| Error::file(name, reason))
 }
 
 /// The numbers of a point-list line: separated by white space or commas.
@@ -21,9 +22,9 @@ fn split_xyz(line: &str) -> Vec<&str> {
         .collect()
 }
 
-fn xyz(bytes: &[u8]) -> Result<RawShape, String> {
+pub(super) fn xyz(bytes: &[u8], cancel: &Cancel) -> Result<RawShape, String> {
     let text = text_of(bytes);
-    let mut lines = data_lines(&text).peekable();
+    let mut lines = data_lines(&text, cancel).peekable();
     let mut declared = None;
     if let Some((line, content)) = lines.peek() {
         if let [single] = split_xyz(content)[..] {

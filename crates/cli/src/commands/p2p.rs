@@ -4,6 +4,7 @@ use crate::output::outln;
 use std::path::PathBuf;
 
 use serde_json::json;
+use shapecorr::pipeline::PairJob;
 use shapecorr::Error;
 use shapecorr::PointwiseCorrespondence;
 
@@ -28,7 +29,7 @@ pub struct P2pArgs {
 
 impl P2pArgs {
     pub fn run(&self) -> Result<(), Error> {
-        let (options, pointwise) = self.options.pointwise()?;
+        let (mut options, pointwise) = self.options.pointwise()?;
         let out = &self.out;
         let names = [
             "map_b_to_a.txt",
@@ -39,13 +40,25 @@ impl P2pArgs {
             "b_mapped.ply",
         ];
         create_out_dir(out, &names, &[&self.pair.a, &self.pair.b])?;
-        let (shape_a, shape_b) = self.pair.read()?;
+        let mut progress = TerminalProgress::new();
+        let mut budget = options.params.budget.clone();
+        let job = PairJob {
+            params: &options.params,
+            map: Some(&pointwise),
+        };
+        let read = self.pair.read_in_budget(
+            &mut budget,
+            |files| job.check_files(files).map(|_| ()),
+            &mut progress,
+        );
+        let (shape_a, shape_b) = read.inspect_err(|_| end_progress_line())?;
+        options.params.budget = budget;
         let result = PointwiseCorrespondence::compute(
             &shape_a,
             &shape_b,
             &options.params,
             &pointwise,
-            &mut TerminalProgress::new(),
+            &mut progress,
         );
         end_progress_line();
         let result = result.map_err(|e| self.pair.naming(e))?;

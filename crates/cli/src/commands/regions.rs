@@ -5,7 +5,7 @@ use crate::output::outln;
 use std::path::PathBuf;
 
 use serde_json::json;
-use shapecorr::pipeline::{Correspondence, Symmetry};
+use shapecorr::pipeline::{Correspondence, PairJob, Symmetry};
 use shapecorr::Error;
 
 use crate::input::{read_input, ShapePairArgs};
@@ -31,16 +31,23 @@ pub struct MatchArgs {
 
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
-        let options = self.options.options()?;
+        let mut options = self.options.options()?;
         let out = &self.out;
         create_out_dir(out, &MATCH_FILES, &[&self.pair.a, &self.pair.b])?;
-        let (shape_a, shape_b) = self.pair.read()?;
-        let result = Correspondence::compute(
-            &shape_a,
-            &shape_b,
-            &options.params,
-            &mut TerminalProgress::new(),
+        let mut progress = TerminalProgress::new();
+        let mut budget = options.params.budget.clone();
+        let job = PairJob {
+            params: &options.params,
+            map: None,
+        };
+        let read = self.pair.read_in_budget(
+            &mut budget,
+            |files| job.check_files(files).map(|_| ()),
+            &mut progress,
         );
+        let (shape_a, shape_b) = read.inspect_err(|_| end_progress_line())?;
+        options.params.budget = budget;
+        let result = Correspondence::compute(&shape_a, &shape_b, &options.params, &mut progress);
         end_progress_line();
         let result = result.map_err(|e| self.pair.naming(e))?;
         let mut value = correspondence_json(&shape_a, &shape_b, &result);
