@@ -138,6 +138,7 @@ fn onto_a(n_vertices_a: usize, points: &[([u32; 3], [f64; 3])]) -> SurfaceMap {
             .map(|&(vertices, weights)| SurfacePoint { vertices, weights })
             .collect(),
         n_vertices_a,
+        fingerprint_a: 0,
     }
 }
 
