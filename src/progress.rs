@@ -95,12 +95,25 @@ impl Cancel {
         }
     }
 
+    /// [`Cancel::check`] when `i` is a multiple of [`CHECK_EVERY`]: for the loops over
+    /// millions of elements (the repairs), at about a millisecond between looks.
+    pub fn check_every(&self, i: usize) -> crate::Result<()> {
+        if i.is_multiple_of(CHECK_EVERY) {
+            self.check()
+        } else {
+            Ok(())
+        }
+    }
+
     /// Publishes the fraction done (0 to 1) for the next report.
     pub fn set_fraction(&self, fraction: f32) {
         self.fraction
             .store(fraction.to_bits(), std::sync::atomic::Ordering::Relaxed);
     }
 }
+
+/// Elements between two looks at the flag in [`Cancel::check_every`].
+pub const CHECK_EVERY: usize = 4096;
 
 /// How often [`polled`] reports while the work runs: a cancel is seen within this time (plus
 /// the work's own polling interval). The target is 0.2 s (docs/decisions.md, "Cancellation

@@ -366,7 +366,7 @@ impl Shape {
                 required: MIN_VERTICES,
             });
         }
-        let mut representative = representatives(&vertices, &active);
+        let mut representative = representatives(&vertices, &active, cancel)?;
         cancel.check()?;
         for (v, rep) in representative.iter_mut().enumerate() {
             let root = welded_to[v];
@@ -399,7 +399,7 @@ impl Shape {
                         .push(Warning::NeedleOrZeroAreaFaces { count: needles });
                 }
                 cancel.check()?;
-                shape.check_edges();
+                shape.check_edges(cancel)?;
             }
             ShapeKind::PointCloud => {
                 let extent = bounding_box_diagonal(&shape.active_points());
@@ -411,7 +411,7 @@ impl Shape {
             }
         }
         cancel.check()?;
-        shape.n_pieces = shape.count_pieces();
+        shape.n_pieces = shape.count_pieces(cancel)?;
         if shape.n_pieces > 1 {
             shape.warnings.push(Warning::DisconnectedPieces {
                 count: shape.n_pieces,
@@ -432,7 +432,7 @@ impl Shape {
     ) -> Result<Repaired> {
         let n = vertices.len();
         // Indices are checked before anything looks at them.
-        let mut triangles = clean_faces(vertices, polygons, warnings)?;
+        let mut triangles = clean_faces(vertices, polygons, warnings, cancel)?;
         if triangles.is_empty() {
             return Err(Error::ZeroArea {
                 detail: if polygons.is_empty() {
@@ -469,14 +469,14 @@ impl Shape {
         let kept = used_by(&triangles);
         let size = repair::robust_size(vertices, &kept);
         cancel.check()?;
-        let welded_to = repair::weld(vertices, &kept, repairs.weld_tolerance * size);
+        let welded_to = repair::weld(vertices, &kept, repairs.weld_tolerance * size, cancel)?;
         cancel.check()?;
         let welded = kept.iter().filter(|&&v| welded_to[v as usize] != v).count();
         if welded > 0 {
             for t in &mut triangles {
                 *t = t.map(|v| welded_to[v as usize]);
             }
-            let (degenerate, duplicate) = drop_improper_faces(&mut triangles);
+            let (degenerate, duplicate) = drop_improper_faces(&mut triangles, cancel)?;
             warnings.push(Warning::VerticesWelded { count: welded });
             if degenerate + duplicate > 0 {
                 warnings.push(Warning::DegenerateFacesDropped {
@@ -485,7 +485,8 @@ impl Shape {
             }
         }
         cancel.check()?;
-        let keep = repair::keep_large_pieces(vertices, &triangles, repairs.debris_fraction);
+        let keep =
+            repair::keep_large_pieces(vertices, &triangles, repairs.debris_fraction, cancel)?;
         cancel.check()?;
         if keep.iter().any(|&k| !k) {
             let before = used_by(&triangles).len();
@@ -548,7 +549,7 @@ impl Shape {
         }
         cancel.check()?;
         let size = repair::robust_size(vertices, &active);
-        let welded_to = repair::weld(vertices, &active, repairs.weld_tolerance * size);
+        let welded_to = repair::weld(vertices, &active, repairs.weld_tolerance * size, cancel)?;
         cancel.check()?;
         let before = active.len();
         active.retain(|&v| welded_to[v as usize] == v);
@@ -559,7 +560,7 @@ impl Shape {
         }
         if repairs.outliers && active.len() >= MIN_VERTICES {
             let before = active.len();
-            active = repair::dense_points(vertices, &active);
+            active = repair::dense_points(vertices, &active, cancel)?;
             if active.len() < before {
                 warnings.push(Warning::OutlierPointsDropped {
                     count: before - active.len(),
@@ -569,8 +570,12 @@ impl Shape {
         cancel.check()?;
         if active.len() >= MIN_VERTICES {
             let before = active.len();
-            let (kept, pieces) =
-                repair::keep_large_cloud_pieces(vertices, &active, repairs.debris_fraction);
+            let (kept, pieces) = repair::keep_large_cloud_pieces(
+                vertices,
+                &active,
+                repairs.debris_fraction,
+                cancel,
+            )?;
             if pieces > 0 {
                 warnings.push(Warning::SmallPiecesDropped {
                     pieces,
@@ -858,11 +863,12 @@ impl Shape {
     }
 
     /// Counts non-manifold edges and orientation conflicts and records them as warnings.
-    fn check_edges(&mut self) {
+    fn check_edges(&mut self, cancel: &Cancel) -> Result<()> {
         // For every undirected edge: number of faces using it, and how many of them run it
         // from low to high.
         let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
-        for t in &self.triangles {
+        for (i, t) in self.triangles.iter().enumerate() {
+            cancel.check_every(i)?;
             for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
                 let entry = uses.entry((a.min(b), a.max(b))).or_insert((0, 0));
                 entry.0 += 1;
@@ -885,17 +891,35 @@ impl Shape {
             self.warnings
                 .push(Warning::InconsistentOrientation { edges: flipped });
         }
+        Ok(())
     }
 
-    fn count_pieces(&self) -> usize {
+    fn count_pieces(&self, cancel: &Cancel) -> Result<usize> {
         let mut sets = DisjointSets::new(self.vertices.len());
-        for (a, b) in self.edges() {
-            sets.union(a as usize, b as usize);
+        match self.kind {
+            // The triangles' sides join the same vertices as the sorted edges, with no sort.
+            ShapeKind::Mesh => {
+                for (i, t) in self.triangles.iter().enumerate() {
+                    cancel.check_every(i)?;
+                    sets.union(t[0] as usize, t[1] as usize);
+                    sets.union(t[1] as usize, t[2] as usize);
+                }
+            }
+            ShapeKind::PointCloud => {
+                for (i, (a, b)) in self.edges().into_iter().enumerate() {
+                    cancel.check_every(i)?;
+                    sets.union(a as usize, b as usize);
+                }
+            }
         }
-        let mut roots: Vec<usize> = self.active.iter().map(|&v| sets.find(v as usize)).collect();
+        let mut roots: Vec<usize> = Vec::with_capacity(self.active.len());
+        for (i, &v) in self.active.iter().enumerate() {
+            cancel.check_every(i)?;
+            roots.push(sets.find(v as usize));
+        }
         roots.sort_unstable();
         roots.dedup();
-        roots.len()
+        Ok(roots.len())
     }
 }
 
@@ -917,11 +941,13 @@ fn clean_faces(
     vertices: &[[f64; 3]],
     polygons: &[&[u32]],
     warnings: &mut Vec<Warning>,
+    cancel: &Cancel,
 ) -> Result<Vec<[u32; 3]>> {
     let n = vertices.len();
     let mut triangles = Vec::with_capacity(polygons.len());
     let mut n_polygons = 0;
     for (face, polygon) in polygons.iter().enumerate() {
+        cancel.check_every(face)?;
         if polygon.len() < 3 {
             return Err(Error::FaceTooSmall {
                 face,
@@ -943,7 +969,7 @@ fn clean_faces(
     if n_polygons > 0 {
         warnings.push(Warning::PolygonsTriangulated { count: n_polygons });
     }
-    let (degenerate, duplicate) = drop_improper_faces(&mut triangles);
+    let (degenerate, duplicate) = drop_improper_faces(&mut triangles, cancel)?;
     if degenerate > 0 {
         warnings.push(Warning::DegenerateFacesDropped { count: degenerate });
     }
@@ -955,18 +981,22 @@ fn clean_faces(
 
 /// Drops the faces with a repeated corner, then those with the same corners as an earlier
 /// face; returns how many of each.
-fn drop_improper_faces(triangles: &mut Vec<[u32; 3]>) -> (usize, usize) {
+fn drop_improper_faces(triangles: &mut Vec<[u32; 3]>, cancel: &Cancel) -> Result<(usize, usize)> {
     let before = triangles.len();
     triangles.retain(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
     let degenerate = before - triangles.len();
     let mut seen = std::collections::HashSet::with_capacity(triangles.len());
-    let before = triangles.len();
-    triangles.retain(|t| {
+    let mut first = Vec::with_capacity(triangles.len());
+    for (i, t) in triangles.iter().enumerate() {
+        cancel.check_every(i)?;
         let mut key = *t;
         key.sort_unstable();
-        seen.insert(key)
-    });
-    (degenerate, before - triangles.len())
+        first.push(seen.insert(key));
+    }
+    let before = triangles.len();
+    let mut first = first.into_iter();
+    triangles.retain(|_| first.next().unwrap_or(true));
+    Ok((degenerate, before - triangles.len()))
 }
 
 /// Splits a polygon into triangles: a quad along its shorter diagonal, larger polygons as
@@ -997,10 +1027,10 @@ fn representative_is_active(active: &[u32], v: u32) -> bool {
 }
 
 /// For every vertex, itself if active, else the nearest active vertex.
-fn representatives(vertices: &[[f64; 3]], active: &[u32]) -> Vec<u32> {
+fn representatives(vertices: &[[f64; 3]], active: &[u32], cancel: &Cancel) -> Result<Vec<u32>> {
     let mut representative: Vec<u32> = (0..vertices.len() as u32).collect();
     if active.len() == vertices.len() {
-        return representative;
+        return Ok(representative);
     }
     let active_points: Vec<[f64; 3]> = active.iter().map(|&v| vertices[v as usize]).collect();
     let tree = PointTree::new(&active_points);
@@ -1009,11 +1039,12 @@ fn representatives(vertices: &[[f64; 3]], active: &[u32]) -> Vec<u32> {
         is_active[v as usize] = true;
     }
     for (v, rep) in representative.iter_mut().enumerate() {
+        cancel.check_every(v)?;
         if !is_active[v] {
             *rep = active[tree.nearest(&vertices[v])];
         }
     }
-    representative
+    Ok(representative)
 }
 
 /// Area of triangle `t`.

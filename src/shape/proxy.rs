@@ -129,9 +129,9 @@ impl Proxy {
 
 /// Triangles per piece of a dense mesh's first simplification pass: meshoptimizer's
 /// simplification is one call that cannot be interrupted, so a piece bounds the wait for a
-/// cancel: 0.62 s measured on 2 cores under a load of 13 (docs/decisions.md, "Dense shapes:
-/// limits").
-pub const PIECE_TRIANGLES: usize = 100_000;
+/// cancel (docs/decisions.md, "Dense shapes: limits": 100K triangles waited 0.62 s on 2
+/// shared cores).
+pub const PIECE_TRIANGLES: usize = 50_000;
 
 /// What the first pass keeps of a dense mesh: this many times the proxy's triangles, so that
 /// the last pass (one call on the whole surface) starts from a mesh of a bounded size.
@@ -200,12 +200,15 @@ fn simplified_in_pieces(
     let axis = (0..3)
         .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
         .unwrap_or(0);
-    let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-    order.par_sort_unstable_by(|&a, &b| {
-        centroid(&triangles[a as usize], axis)
-            .total_cmp(&centroid(&triangles[b as usize], axis))
-            .then(a.cmp(&b))
-    });
+    // The keys computed once, with a look at `cancel` (the sort itself cannot be stopped).
+    let mut keyed: Vec<(f32, u32)> = Vec::with_capacity(triangles.len());
+    for (i, t) in triangles.iter().enumerate() {
+        cancel.check_every(i)?;
+        keyed.push((centroid(t, axis), i as u32));
+    }
+    keyed.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    cancel.check()?;
+    let order: Vec<u32> = keyed.into_iter().map(|(_, i)| i).collect();
     let keep = target_indices as f64 / (3 * triangles.len()) as f64;
     let slabs: Vec<Result<Vec<u32>>> = order
         .par_chunks(piece)

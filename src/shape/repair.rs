@@ -7,11 +7,15 @@
 //! those of the vertex it was welded to, a dropped one those of the nearest kept vertex. Each
 //! repair is reported as a [`super::Warning`] and can be switched off ([`Repairs`]).
 //! Tolerances measured on every shape of `../shared/data` (docs/decisions.md, "Repairs").
+//! The repairs look at a [`Cancel`] every few thousand elements of their loops
+//! (docs/decisions.md, "Dense shapes: limits"); `&Cancel::default()` runs them to the end.
 
 use std::collections::HashMap;
 
 use super::neighbors::PointTree;
 use super::{distance, DisjointSets};
+use crate::progress::Cancel;
+use crate::Result;
 
 /// Which repairs [`super::Shape`] construction makes, and their tolerances.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,21 +104,23 @@ pub fn far_vertices(points: &[[f64; 3]], of: &[u32]) -> Vec<u32> {
 /// For every vertex, the vertex it is welded to: the lowest index among the vertices of
 /// `of` chained to it by distances at most `tolerance` (itself when none; vertices not in
 /// `of` are left alone). Found on a grid of cells of the tolerance's size.
-pub fn weld(points: &[[f64; 3]], of: &[u32], tolerance: f64) -> Vec<u32> {
+pub fn weld(points: &[[f64; 3]], of: &[u32], tolerance: f64, cancel: &Cancel) -> Result<Vec<u32>> {
     let mut root: Vec<u32> = (0..points.len() as u32).collect();
     if !(tolerance > 0.0) || of.is_empty() {
-        return root;
+        return Ok(root);
     }
     let (centre, _) = robust_centre_and_radius(points, of);
     let cell = |p: &[f64; 3]| -> [i64; 3] {
         std::array::from_fn(|c| ((p[c] - centre[c]) / tolerance).floor() as i64)
     };
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(of.len());
-    for &v in of {
+    for (i, &v) in of.iter().enumerate() {
+        cancel.check_every(i)?;
         grid.entry(cell(&points[v as usize])).or_default().push(v);
     }
     let mut sets = DisjointSets::new(points.len());
-    for &v in of {
+    for (i, &v) in of.iter().enumerate() {
+        cancel.check_every(i)?;
         let p = &points[v as usize];
         let [x, y, z] = cell(p);
         for dx in -1..=1 {
@@ -139,10 +145,11 @@ pub fn weld(points: &[[f64; 3]], of: &[u32], tolerance: f64) -> Vec<u32> {
             }
         }
     }
-    for &v in of {
+    for (i, &v) in of.iter().enumerate() {
+        cancel.check_every(i)?;
         root[v as usize] = sets.find(v as usize) as u32;
     }
-    root
+    Ok(root)
 }
 
 /// The triangles to keep: those of every connected piece holding at least `fraction` of the
@@ -151,25 +158,32 @@ pub fn keep_large_pieces(
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
     fraction: f64,
-) -> Vec<bool> {
+    cancel: &Cancel,
+) -> Result<Vec<bool>> {
     let mut sets = DisjointSets::new(vertices.len());
-    for t in triangles {
+    for (i, t) in triangles.iter().enumerate() {
+        cancel.check_every(i)?;
         sets.union(t[0] as usize, t[1] as usize);
         sets.union(t[1] as usize, t[2] as usize);
     }
     let mut area_of: HashMap<usize, f64> = HashMap::new();
-    let roots: Vec<usize> = triangles.iter().map(|t| sets.find(t[0] as usize)).collect();
+    let mut roots: Vec<usize> = Vec::with_capacity(triangles.len());
+    for (i, t) in triangles.iter().enumerate() {
+        cancel.check_every(i)?;
+        roots.push(sets.find(t[0] as usize));
+    }
     let mut total = 0.0;
-    for (t, &r) in triangles.iter().zip(&roots) {
+    for (i, (t, &r)) in triangles.iter().zip(&roots).enumerate() {
+        cancel.check_every(i)?;
         let area = super::triangle_area(vertices, t);
         *area_of.entry(r).or_default() += area;
         total += area;
     }
     let large = |r: &usize| area_of[r] >= fraction * total;
     if !(fraction > 0.0) || !area_of.keys().any(large) {
-        return vec![true; triangles.len()];
+        return Ok(vec![true; triangles.len()]);
     }
-    roots.iter().map(large).collect()
+    Ok(roots.iter().map(large).collect())
 }
 
 /// Two points of a cloud are in one piece when a chain of points joins them, each step at
@@ -192,26 +206,26 @@ struct CloudNeighbourhoods {
 }
 
 impl CloudNeighbourhoods {
-    fn new(points: &[[f64; 3]], of: &[u32]) -> Self {
+    fn new(points: &[[f64; 3]], of: &[u32], cancel: &Cancel) -> Result<Self> {
         let subset: Vec<[f64; 3]> = of.iter().map(|&v| points[v as usize]).collect();
         let tree = PointTree::new(&subset);
         // nearest_k returns squared distances and includes the point itself.
-        let near: Vec<Vec<(usize, f64)>> = subset
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
+        let mut near: Vec<Vec<(usize, f64)>> = Vec::with_capacity(subset.len());
+        for (i, p) in subset.iter().enumerate() {
+            cancel.check_every(i)?;
+            near.push(
                 tree.nearest_k(p, LINK_NEIGHBOURS + 1)
                     .into_iter()
                     .filter(|&(j, _)| j != i)
                     .map(|(j, d2)| (j, d2.sqrt()))
-                    .collect()
-            })
-            .collect();
+                    .collect(),
+            );
+        }
         let spacing = near
             .iter()
             .map(|list| list.get(OUTLIER_NEIGHBOUR - 1).map_or(0.0, |&(_, d)| d))
             .collect();
-        CloudNeighbourhoods { near, spacing }
+        Ok(CloudNeighbourhoods { near, spacing })
     }
 }
 
@@ -222,13 +236,15 @@ pub fn keep_large_cloud_pieces(
     points: &[[f64; 3]],
     of: &[u32],
     fraction: f64,
-) -> (Vec<u32>, usize) {
+    cancel: &Cancel,
+) -> Result<(Vec<u32>, usize)> {
     if !(fraction > 0.0) || of.len() <= LINK_NEIGHBOURS {
-        return (of.to_vec(), 0);
+        return Ok((of.to_vec(), 0));
     }
-    let hood = CloudNeighbourhoods::new(points, of);
+    let hood = CloudNeighbourhoods::new(points, of, cancel)?;
     let mut sets = DisjointSets::new(of.len());
     for (i, list) in hood.near.iter().enumerate() {
+        cancel.check_every(i)?;
         for &(j, d) in list {
             if d <= PIECE_LINK_SPACINGS * hood.spacing[i].max(hood.spacing[j]) {
                 sets.union(i, j);
@@ -242,7 +258,7 @@ pub fn keep_large_cloud_pieces(
     }
     let large = |r: &usize| count[r] as f64 >= fraction * of.len() as f64;
     if !count.keys().any(large) {
-        return (of.to_vec(), 0);
+        return Ok((of.to_vec(), 0));
     }
     let dropped = count.keys().filter(|r| !large(r)).count();
     let kept = of
@@ -251,7 +267,7 @@ pub fn keep_large_cloud_pieces(
         .filter(|(_, r)| large(r))
         .map(|(&v, _)| v)
         .collect();
-    (kept, dropped)
+    Ok((kept, dropped))
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -263,12 +279,14 @@ fn median(mut values: Vec<f64>) -> f64 {
 /// at most [`OUTLIER_SPACING_FACTOR`] times the median spacing of its
 /// [`OUTLIER_NEIGHBOUR`] nearest neighbours (a local outlier factor, so that the density may
 /// vary across the cloud).
-pub fn dense_points(points: &[[f64; 3]], of: &[u32]) -> Vec<u32> {
+pub fn dense_points(points: &[[f64; 3]], of: &[u32], cancel: &Cancel) -> Result<Vec<u32>> {
     if of.len() <= LINK_NEIGHBOURS {
-        return of.to_vec();
+        return Ok(of.to_vec());
     }
-    let hood = CloudNeighbourhoods::new(points, of);
-    of.iter()
+    let hood = CloudNeighbourhoods::new(points, of, cancel)?;
+    cancel.check()?;
+    Ok(of
+        .iter()
         .enumerate()
         .filter(|&(i, _)| {
             let around = median(
@@ -280,5 +298,5 @@ pub fn dense_points(points: &[[f64; 3]], of: &[u32]) -> Vec<u32> {
             hood.spacing[i] <= OUTLIER_SPACING_FACTOR * around
         })
         .map(|(_, &v)| v)
-        .collect()
+        .collect())
 }
