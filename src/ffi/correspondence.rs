@@ -463,8 +463,9 @@ mod tests {
         }
     }
 
-    fn with_verdict(confidence: Option<f64>) -> ScCorrespondence {
-        ScCorrespondence::new(Correspondence {
+    /// A handle as the C API gives one out (an `Arc`'s pointer; see `ffi::boundary`).
+    fn with_verdict(confidence: Option<f64>) -> *const ScCorrespondence {
+        let correspondence = ScCorrespondence::new(Correspondence {
             k: 5,
             graph_a: empty_graph(),
             graph_b: empty_graph(),
@@ -481,7 +482,8 @@ mod tests {
                 confidence,
             }),
             estimate: None,
-        })
+        });
+        std::sync::Arc::into_raw(std::sync::Arc::new(correspondence))
     }
 
     #[test]
@@ -490,24 +492,27 @@ mod tests {
         let sure = with_verdict(Some(0.9));
         let doubtful = with_verdict(Some(0.2));
         unsafe {
-            assert!(sc_correspondence_confidence(&none).is_nan());
-            assert!(sc_correspondence_warning(&none).is_null());
-            assert_eq!(sc_correspondence_confidence(&sure), 0.9);
-            assert!(sc_correspondence_warning(&sure).is_null());
-            assert_eq!(sc_correspondence_confidence(&doubtful), 0.2);
-            let text = sc_correspondence_warning(&doubtful);
+            assert!(sc_correspondence_confidence(none).is_nan());
+            assert!(sc_correspondence_warning(none).is_null());
+            assert_eq!(sc_correspondence_confidence(sure), 0.9);
+            assert!(sc_correspondence_warning(sure).is_null());
+            assert_eq!(sc_correspondence_confidence(doubtful), 0.2);
+            let text = sc_correspondence_warning(doubtful);
             assert!(!text.is_null());
             let text = CStr::from_ptr(text).to_str().unwrap();
             assert_eq!(
                 Some(text.to_string()),
-                doubtful.result.verdict.as_ref().unwrap().warning()
+                (*doubtful).result.verdict.as_ref().unwrap().warning()
             );
             assert!(text.contains("mirror"), "{text}");
             // The same pointer every time: the handle owns the string.
             assert_eq!(
-                sc_correspondence_warning(&doubtful),
-                sc_correspondence_warning(&doubtful)
+                sc_correspondence_warning(doubtful),
+                sc_correspondence_warning(doubtful)
             );
+            for handle in [none, sure, doubtful] {
+                sc_correspondence_free(handle.cast_mut());
+            }
         }
     }
 

@@ -811,8 +811,8 @@ fn transfer_carries_values_like_the_written_surface_map_and_refuses_bad_files() 
     }
     // Bad files: a row short, a word that is not a number, a row count that is not A's.
     let bad = [
-        ("0.5, 1\n0.5\n", "line 2 has 1 values"),
-        ("0.5, one\n", "line 1: `one` is not a number"),
+        ("0.5, 1\n0.5\n", "line 2: 1 values, the first row has 2"),
+        ("0.5, one\n", "line 1: column 2: `one` is not a number"),
         ("0.5, 1\n", "1 rows of values, but shape A has"),
     ];
     for (content, message) in bad {
