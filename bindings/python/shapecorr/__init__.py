@@ -1045,20 +1045,20 @@ class SurfaceMap(_Handle):
         ``(n_b_triangles, 3)`` or ``(n_b_triangles, 3, channels)``. Face indices must be
         integers (TypeError for floats) in the range of uint32 (ValueError)."""
         _expect(a, Shape, "a")
-        faces_a = _faces(faces_a, "faces_a")
-        faces_b = _faces(faces_b, "faces_b")
+        triangles_a = _faces(faces_a, "faces_a")
+        triangles_b = _faces(faces_b, "faces_b")
         values = np.asarray(corner_values)
         if values.dtype.kind not in "biuf":
             raise TypeError(f"corner_values must be numbers, got an array of {values.dtype}")
         values = np.ascontiguousarray(values, dtype=np.float64)
-        if values.ndim not in (2, 3) or values.shape[:2] != (len(faces_a), 3):
-            raise ValueError(f"corner_values must be ({len(faces_a)}, 3[, channels]), got {values.shape}")
+        if values.ndim not in (2, 3) or values.shape[:2] != (len(triangles_a), 3):
+            raise ValueError(f"corner_values must be ({len(triangles_a)}, 3[, channels]), got {values.shape}")
         channels = 1 if values.ndim == 2 else values.shape[2]
-        shape = (len(faces_b), 3) if values.ndim == 2 else (len(faces_b), 3, channels)
+        shape = (len(triangles_b), 3) if values.ndim == 2 else (len(triangles_b), 3, channels)
         out = np.empty(shape, dtype=np.float64)
         _check(lib.sc_surface_map_transfer_corners(
-            self, a, _ptr(faces_a, ctypes.c_uint32), faces_a.size, _ptr(values, ctypes.c_double),
-            values.size, _ptr(faces_b, ctypes.c_uint32), faces_b.size, channels,
+            self, a, _ptr(triangles_a, ctypes.c_uint32), triangles_a.size, _ptr(values, ctypes.c_double),
+            values.size, _ptr(triangles_b, ctypes.c_uint32), triangles_b.size, channels,
             _ptr(out, ctypes.c_double), out.size,
         ))
         return out
