@@ -86,7 +86,7 @@ def test_summary_matrix_and_a_resumed_run(local_run, figures, tmp_path):
     before = (local_run / "pairs.jsonl").read_bytes()
     batch.match_pairs(figures, local_run, workers=2)
     assert (local_run / "pairs.jsonl").read_bytes() == before
-    with pytest.raises(ValueError, match="other settings"):
+    with pytest.raises(shapecorr.ShapecorrError, match="other settings"):
         batch.match_pairs(figures, local_run, k_max=8)
 
 
