@@ -176,18 +176,7 @@ fn write_basis(path: &Path, key: &str, basis: &Eigenbasis, seconds: f64) -> Resu
     }
     let checksum = Sha256::digest(&bytes);
     bytes.extend_from_slice(&checksum);
-    let tmp = path.with_extension(format!(
-        "tmp{}-{}",
-        std::process::id(),
-        super::thread_number()
-    ));
-    let written = std::fs::write(&tmp, &bytes)
-        .map_err(|e| Error::file(&tmp, e.to_string()))
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::file(path, e.to_string())));
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written
+    super::write_whole(path, &bytes)
 }
 
 /// Reads a basis written by [`write_basis`] under `key`: None when there is no entry (or

@@ -473,8 +473,14 @@ pub fn write_map(path: &Path, map: &[u32]) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, e.to_string()))?;
     }
     let bytes: Vec<u8> = map.iter().flat_map(|v| v.to_le_bytes()).collect();
+    write_whole(path, &bytes)
+}
+
+/// Writes `bytes` to `path` whole or not at all: a temporary file next to it (named by
+/// process and thread) renamed into place, removed when either step fails.
+pub(crate) fn write_whole(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension(format!("tmp{}-{}", std::process::id(), thread_number()));
-    let written = std::fs::write(&tmp, &bytes)
+    let written = std::fs::write(&tmp, bytes)
         .map_err(|e| Error::file(&tmp, e.to_string()))
         .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::file(path, e.to_string())));
     if written.is_err() {
