@@ -17,6 +17,7 @@
 use std::fmt;
 
 use crate::maps::fmap::ZoomOutParams;
+use crate::maps::placement::{Placement, PLACEMENT_NAMES};
 use crate::maps::pointwise::{PointwiseParams, Refinement, RegionConstraints};
 use crate::pipeline::Params;
 use crate::{Error, Result};
@@ -591,6 +592,15 @@ pub const OPTIONS: &[OptionInfo] = &[
         field!(Params, Float, budget.time_limit_s),
     )
     .range(0.0, 1e7),
+    regions(
+        "placement",
+        "use where the shapes stand to choose among the answers: 0 auto (when informative), 1 ignore, 2 trust",
+        Field::Int(
+            |p: &Params| p.placement as i64,
+            |p: &mut Params, v| p.placement = Placement::ALL[v as usize],
+        ),
+    )
+    .with_choices(&PLACEMENT_NAMES),
 ];
 
 /// The option called `name`.
@@ -1101,7 +1111,8 @@ mod tests {
             choices,
             [
                 ("p2p_regions", &P2P_REGIONS_NAMES[..]),
-                ("p2p_refinement", &P2P_REFINEMENT_NAMES[..])
+                ("p2p_refinement", &P2P_REFINEMENT_NAMES[..]),
+                ("placement", &PLACEMENT_NAMES[..])
             ]
         );
         for info in OPTIONS.iter().filter(|o| !o.choices.is_empty()) {
@@ -1151,7 +1162,7 @@ mod tests {
         let last = OPTIONS.last().unwrap();
         assert_eq!(
             (last.name, last.option_type),
-            ("time_limit_s", OptionType::Float)
+            ("placement", OptionType::Int)
         );
         assert!(Options::default().pointwise().hypotheses);
         let mut options = Options::default();

@@ -460,6 +460,10 @@ mod tests {
             },
             fmap_ab: faer::Mat::zeros(2, 2),
             distance_to_chosen,
+            rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            turn_degrees: 0.0,
+            landmark_error: None,
+            one_to_one: Vec::new(),
         }
     }
 
@@ -480,6 +484,9 @@ mod tests {
                     score(HypothesisKind::Mirror, 0.051, 0.3),
                 ],
                 confidence,
+                decided_by: crate::maps::hypotheses::Decision::Cost,
+                distances: vec![vec![0.0, 0.3], vec![0.3, 0.0]],
+                ruled_out: vec![false; 2],
             }),
             estimate: None,
         });

@@ -39,6 +39,9 @@ pub enum HypothesisKind {
     /// The answer with the matching of one symmetric group (its index among the groups with
     /// a choice) replaced by another.
     Alternative(usize),
+    /// The map the shapes' placement gives ([`crate::maps::placement::nearest_in_frame`]),
+    /// no region constraint.
+    Placement,
 }
 
 impl HypothesisKind {
@@ -49,6 +52,7 @@ impl HypothesisKind {
             HypothesisKind::Mirror => "mirror".into(),
             HypothesisKind::Symmetric => "symmetric".into(),
             HypothesisKind::Alternative(g) => format!("alternative {g}"),
+            HypothesisKind::Placement => "placement".into(),
         }
     }
 }
@@ -98,6 +102,46 @@ pub struct HypothesisScore {
     /// Mean distance between the images of B's samples under this map and the chosen one,
     /// on the unit-area A (0 for the chosen one).
     pub distance_to_chosen: f64,
+    /// The rigid rotation (rows) that best carries B's samples onto their images on A
+    /// ([`crate::maps::placement::best_rotation`]): where the map says B stands in A's frame.
+    pub rotation: [[f64; 3]; 3],
+    /// That rotation's angle, in degrees.
+    pub turn_degrees: f64,
+    /// Mean distance between each landmark of B's image and its partner on A, on the
+    /// unit-area A (None without landmarks).
+    pub landmark_error: Option<f64>,
+    /// The hypothesis's one-to-one region matches, sorted by A region (empty for the
+    /// symmetric one, which makes no choice inside a group).
+    pub one_to_one: Vec<(u32, u32)>,
+}
+
+/// What settled the choice among the hypotheses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Decision {
+    /// The lowest [`MapEnergy::cost`].
+    Cost,
+    /// A close call settled at full resolution ([`CLOSE_CALL`]).
+    CloseCall,
+    /// The shapes' placement ([`crate::maps::placement`]).
+    Placement,
+    /// The landmarks: the hypothesis whose map carries them nearest their partners.
+    Landmarks,
+    /// The user took the runner-up ([`Verdict::other`]).
+    OtherAnswer,
+}
+
+impl Decision {
+    /// A short name: `cost`, `close call`, `placement`, `landmarks`, `other answer`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Decision::Cost => "cost",
+            Decision::CloseCall => "close call",
+            Decision::Placement => "placement",
+            Decision::Landmarks => "landmarks",
+            Decision::OtherAnswer => "other answer",
+        }
+    }
 }
 
 /// The choice among the hypotheses and how sure it is.
@@ -110,6 +154,14 @@ pub struct Verdict {
     /// In [0, 1]: high when the chosen map is consistent and clearly better than the
     /// runner-up ([`confidence`]).
     pub confidence: f64,
+    /// What settled the choice.
+    pub decided_by: Decision,
+    /// Mean distance between the images of B's samples under every two hypotheses' maps,
+    /// on the unit-area A: `distances[h][g]`.
+    pub distances: Vec<Vec<f64>>,
+    /// The hypotheses the shapes' placement or the landmarks ruled out: they do not count as
+    /// competitors in the confidence.
+    pub ruled_out: Vec<bool>,
 }
 
 /// Below this confidence an answer is reported as doubtful (calibrated on the development
@@ -527,31 +579,21 @@ impl Verdict {
 
     /// Settles a close call with the full-resolution consistencies of the chosen hypothesis
     /// and its competitor `rival`: the more consistent is chosen (the chosen one keeps ties).
-    /// When that changes the choice, `distance_to_chosen` follows it (`sample_maps`, on A's
-    /// vertices `va` of area `area_a`) and the confidence becomes the new choice's
+    /// When that changes the choice, `distance_to_chosen` follows it and the confidence
+    /// becomes the new choice's
     /// consistency factor times the relative full-resolution margin against
     /// [`FULL_MARGIN_SCALE`], at most the confidence before (a close call stays as doubtful
     /// as it was). Returns whether the choice changed.
-    pub fn settle(
-        &mut self,
-        rival: usize,
-        (chosen_full, rival_full): (f64, f64),
-        sample_maps: &[&[u32]],
-        (va, area_a): (&[[f64; 3]], f64),
-    ) -> bool {
+    pub fn settle(&mut self, rival: usize, (chosen_full, rival_full): (f64, f64)) -> bool {
         if rival_full <= chosen_full {
             return false;
         }
-        self.chosen = rival;
-        let scale = 1.0 / area_a.sqrt();
-        for (h, score) in self.scores.iter_mut().enumerate() {
-            score.distance_to_chosen =
-                mean_image_distance(sample_maps[h], sample_maps[rival], va) * scale;
-        }
+        let before = self.confidence;
+        self.choose(rival, Decision::CloseCall);
         let relative = (rival_full - chosen_full) / rival_full.max(1e-12);
         let consistency = (-self.chosen().energy.cost() / COST_SCALE).exp();
         let margin = 1.0 - (-relative / FULL_MARGIN_SCALE).exp();
-        self.confidence = (consistency * margin).clamp(0.0, self.confidence);
+        self.confidence = (consistency * margin).clamp(0.0, before);
         true
     }
 }
@@ -593,6 +635,14 @@ pub fn choose(
             chosen = h;
         }
     }
+    let n = kinds.len();
+    let distances: Vec<Vec<f64>> = (0..n)
+        .map(|h| {
+            (0..n)
+                .map(|g| mean_image_distance(sample_maps[h], sample_maps[g], va) * scale)
+                .collect()
+        })
+        .collect();
     let scores: Vec<HypothesisScore> = kinds
         .into_iter()
         .zip(energies)
@@ -602,8 +652,11 @@ pub fn choose(
             kind,
             energy,
             fmap_ab,
-            distance_to_chosen: mean_image_distance(sample_maps[h], sample_maps[chosen], va)
-                * scale,
+            distance_to_chosen: distances[h][chosen],
+            rotation: IDENTITY,
+            turn_degrees: 0.0,
+            landmark_error: None,
+            one_to_one: Vec::new(),
         })
         .collect();
     let confidence = confidence(&scores, chosen);
@@ -611,6 +664,111 @@ pub fn choose(
         chosen,
         scores,
         confidence,
+        decided_by: Decision::Cost,
+        distances,
+        ruled_out: vec![false; n],
+    }
+}
+
+const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Landmark errors within this distance of the best one (on the unit-area A) count as
+/// equally good: the cost decides among them. About a twentieth of a body's height.
+pub const LANDMARK_TOLERANCE: f64 = 0.05;
+
+impl Verdict {
+    /// Chooses `h`, settled by `by`: the distances to the chosen one and the confidence
+    /// follow (hypotheses in `ruled_out` are not competitors).
+    pub fn choose(&mut self, h: usize, by: Decision) {
+        self.chosen = h;
+        self.decided_by = by;
+        for (g, score) in self.scores.iter_mut().enumerate() {
+            score.distance_to_chosen = self.distances[g][h];
+        }
+        self.confidence = confidence_excluding(&self.scores, h, &self.ruled_out);
+    }
+
+    /// Applies what the shapes' placement says ([`crate::maps::placement::frame_pick`] on
+    /// every hypothesis's `turn_degrees`): when the frame picks a hypothesis, it is chosen
+    /// and the hypotheses it rules out (a different map implying a turn beyond
+    /// [`crate::maps::placement::NEAR_TURN`]) no longer lower the confidence. Returns whether
+    /// the frame was used.
+    pub fn apply_placement(&mut self, mode: crate::maps::placement::Placement) -> bool {
+        use crate::maps::placement::{frame_pick, NEAR_TURN};
+        let turns: Vec<f64> = self.scores.iter().map(|s| s.turn_degrees).collect();
+        let costs: Vec<f64> = self.scores.iter().map(|s| s.energy.cost()).collect();
+        let eligible = |h: usize| self.scores[h].kind != HypothesisKind::Symmetric;
+        let different = |h: usize, g: usize| self.distances[h][g] > DIFFERENT_MAP;
+        let Some(pick) = frame_pick(mode, &turns, &costs, &eligible, &different) else {
+            return false;
+        };
+        for (h, out) in self.ruled_out.iter_mut().enumerate() {
+            *out = different(h, pick) && turns[h] > NEAR_TURN;
+        }
+        self.choose(pick, Decision::Placement);
+        true
+    }
+
+    /// Applies the landmarks (each hypothesis's `landmark_error`): among the definite
+    /// hypotheses, those within [`LANDMARK_TOLERANCE`] of the smallest error remain, and the
+    /// cheapest of them (or the frame's pick, when it is among them) is chosen; the others
+    /// are ruled out. Returns whether the choice changed.
+    pub fn apply_landmarks(&mut self) -> bool {
+        let errors: Vec<f64> = self
+            .scores
+            .iter()
+            .map(|s| s.landmark_error.unwrap_or(f64::INFINITY))
+            .collect();
+        let definite = |h: usize| self.scores[h].kind != HypothesisKind::Symmetric;
+        let best = (0..errors.len())
+            .filter(|&h| definite(h))
+            .map(|h| errors[h])
+            .fold(f64::INFINITY, f64::min);
+        if !best.is_finite() {
+            return false;
+        }
+        let kept = |h: usize| definite(h) && errors[h] <= best + LANDMARK_TOLERANCE;
+        for h in 0..errors.len() {
+            self.ruled_out[h] = self.ruled_out[h] || !kept(h);
+        }
+        if kept(self.chosen) {
+            self.confidence = confidence_excluding(&self.scores, self.chosen, &self.ruled_out);
+            return false;
+        }
+        let pick = (0..errors.len())
+            .filter(|&h| kept(h))
+            .min_by(|&x, &y| {
+                let (cx, cy) = (self.scores[x].energy.cost(), self.scores[y].energy.cost());
+                cx.total_cmp(&cy).then(x.cmp(&y))
+            })
+            .expect("the hypothesis of the smallest error is kept");
+        self.choose(pick, Decision::Landmarks);
+        true
+    }
+
+    /// The runner-up: the cheapest definite hypothesis whose map differs from the chosen
+    /// one ([`DIFFERENT_MAP`]), whether or not the frame or the landmarks ruled it out.
+    pub fn runner_up(&self) -> Option<usize> {
+        self.scores
+            .iter()
+            .enumerate()
+            .filter(|(h, s)| {
+                *h != self.chosen
+                    && s.kind != HypothesisKind::Symmetric
+                    && s.distance_to_chosen > DIFFERENT_MAP
+            })
+            .min_by(|x, y| x.1.energy.cost().total_cmp(&y.1.energy.cost()))
+            .map(|(h, _)| h)
+    }
+
+    /// The verdict with the runner-up chosen ([`Verdict::runner_up`]; its confidence as if it
+    /// had been chosen, nothing ruled out), or None when there is no runner-up.
+    pub fn other(&self) -> Option<Verdict> {
+        let h = self.runner_up()?;
+        let mut other = self.clone();
+        other.ruled_out = vec![false; self.scores.len()];
+        other.choose(h, Decision::OtherAnswer);
+        Some(other)
     }
 }
 
@@ -644,12 +802,18 @@ pub const DIFFERENT_MAP: f64 = 0.05;
 /// whose map differs by more than [`DIFFERENT_MAP`]; the relative cost margin against
 /// [`MARGIN_SCALE`]). No competitor: margin factor 1. In [0, 1].
 pub fn confidence(scores: &[HypothesisScore], chosen: usize) -> f64 {
+    confidence_excluding(scores, chosen, &vec![false; scores.len()])
+}
+
+/// [`confidence`] with the hypotheses in `ruled_out` not counted as competitors.
+pub fn confidence_excluding(scores: &[HypothesisScore], chosen: usize, ruled_out: &[bool]) -> f64 {
     let best = scores[chosen].energy.cost();
     let consistency = (-best / COST_SCALE).exp();
     let runner_up = scores
         .iter()
-        .filter(|s| s.distance_to_chosen > DIFFERENT_MAP)
-        .map(|s| s.energy.cost())
+        .zip(ruled_out)
+        .filter(|(s, out)| s.distance_to_chosen > DIFFERENT_MAP && !**out)
+        .map(|(s, _)| s.energy.cost())
         .fold(f64::INFINITY, f64::min);
     let margin = if runner_up.is_finite() {
         let relative = (runner_up - best) / runner_up.max(1e-12);
@@ -836,13 +1000,24 @@ pub fn one_to_one_from_map(
     p2p_ba: &[u32],
     mass_b: &[f64],
 ) -> Vec<(u32, u32)> {
+    one_to_one_from_samples(regions, (None, mass_b), p2p_ba)
+}
+
+/// [`one_to_one_from_map`] on a map from B's samples (`samples_b`, weighted by `weights`;
+/// None: every vertex of B, weighted by its mass) to vertices of A.
+pub fn one_to_one_from_samples(
+    regions: RegionMatches<'_>,
+    (samples_b, weights): (Option<&[u32]>, &[f64]),
+    p2p: &[u32],
+) -> Vec<(u32, u32)> {
     let choices = GroupChoices::new(regions);
     let (labels_a, labels_b) = (regions.labels_a, regions.labels_b);
     let n_a = regions.n_regions_a;
     let mut overlap = vec![0.0; n_a * regions.n_regions_b];
-    for (v, &x) in p2p_ba.iter().enumerate() {
+    for (s, &x) in p2p.iter().enumerate() {
+        let v = samples_b.map_or(s, |samples| samples[s] as usize);
         let (i, j) = (labels_a[x as usize] as usize, labels_b[v] as usize);
-        overlap[j * n_a + i] += mass_b[v];
+        overlap[j * n_a + i] += weights[s];
     }
     let held = |pairs: &[(u32, u32)]| -> f64 {
         pairs

@@ -12,11 +12,13 @@ use faer::Mat;
 use rayon::prelude::*;
 
 use crate::maps::fmap::{
-    fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, project,
-    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
+    fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, p2p_to_fmap,
+    project, solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
 };
 pub use crate::maps::hypotheses::orientation_score;
-use crate::maps::hypotheses::{self, HypothesisKind, RegionGroups, Verdict};
+use crate::maps::hypotheses::{self, Decision, HypothesisKind, RegionGroups, Verdict};
+use crate::maps::landmarks::{landmark_error, Landmark};
+use crate::maps::placement::{self, Guidance, Placement};
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::regions::RegionMatches;
 use crate::shape::Shape;
@@ -203,6 +205,9 @@ pub struct PointwiseMap {
     /// The region hypotheses verified at the map level, the chosen one and its confidence
     /// (None when there was one hypothesis only).
     pub verdict: Option<Verdict>,
+    /// The runner-up's map ([`Verdict::runner_up`]), for the user who takes the other
+    /// answer; None when there is none.
+    pub other_p2p_ba: Option<Vec<u32>>,
     /// Seconds of the first functional map and of its refinement.
     pub timings: PointwiseTimings,
 }
@@ -220,8 +225,21 @@ impl PointwiseMap {
         params: &PointwiseParams,
         progress: &mut dyn Progress,
     ) -> Result<PointwiseMap> {
+        PointwiseMap::guided(a, b, regions, params, &Guidance::default(), progress)
+    }
+
+    /// [`PointwiseMap::from_bases`] with what the user knows beyond the shapes' geometry
+    /// (`guidance`: the placement's use, landmarks as vertices of these shapes).
+    pub fn guided(
+        a: ShapeBasis<'_>,
+        b: ShapeBasis<'_>,
+        regions: Option<RegionMatches<'_>>,
+        params: &PointwiseParams,
+        guidance: &Guidance,
+        progress: &mut dyn Progress,
+    ) -> Result<PointwiseMap> {
         polled(progress, Stage::PointwiseMap, (0.0, 1.0), |cancel| {
-            PointwiseMap::solve(a, b, regions, params, cancel)
+            PointwiseMap::solve(a, b, regions, (params, guidance), cancel)
         })
     }
 
@@ -230,7 +248,7 @@ impl PointwiseMap {
         side_a: ShapeBasis<'_>,
         side_b: ShapeBasis<'_>,
         regions: Option<RegionMatches<'_>>,
-        params: &PointwiseParams,
+        (params, guidance): (&PointwiseParams, &Guidance),
         cancel: &Cancel,
     ) -> Result<PointwiseMap> {
         let ShapeBasis {
@@ -273,7 +291,7 @@ impl PointwiseMap {
             }
             _ => vec![(HypothesisKind::Answer, groups)],
         };
-        let (kinds, candidates): (Vec<HypothesisKind>, Vec<RegionGroups>) =
+        let (mut kinds, candidates): (Vec<HypothesisKind>, Vec<RegionGroups>) =
             kinds_and_groups.into_iter().unzip();
         let candidate_refs: Vec<&[(Vec<u32>, Vec<u32>)]> =
             candidates.iter().map(Vec::as_slice).collect();
@@ -287,26 +305,35 @@ impl PointwiseMap {
             regions,
             &candidate_refs,
             orientation_faces,
-            params,
+            (params, &guidance.landmarks),
             k,
         )?;
         cancel.check()?;
         cancel.set_fraction(0.2);
-        let fmaps = (0..candidates.len())
+        let mut fmaps = (0..candidates.len())
             .into_par_iter()
             .map(|c| features.solve(c, (basis_a, basis_b), params, cancel))
             .collect::<Result<Vec<_>>>()?;
+        // Hypotheses are verified: the shapes' placement gives one more.
+        if fmaps.len() > 1 && guidance.placement != Placement::Ignore {
+            let area = |basis: &Eigenbasis| basis.mass.iter().sum::<f64>();
+            let p2p = placement::nearest_in_frame(
+                (a, &basis_a.mass, area(basis_a)),
+                (b, &basis_b.mass, area(basis_b)),
+            );
+            let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+            fmaps.push(p2p_to_fmap(&p2p, phi_a, phi_b, &basis_b.mass, k, k));
+            kinds.push(HypothesisKind::Placement);
+        }
         cancel.set_fraction(0.4);
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
-        let (fmap_ab, p2p_ba, verdict) = if fmaps.len() > 1 {
+        let (fmap_ab, mut p2p_ba, verdict) = if fmaps.len() > 1 {
             let (verdict, chosen_map) = verified(
-                side_a,
-                side_b,
-                faces.as_ref(),
-                kinds,
+                (side_a, side_b, faces.as_ref()),
+                (kinds, &candidates, regions),
                 &fmaps,
-                (params, k),
+                (params, guidance, k),
                 cancel,
             )?;
             cancel.set_fraction(0.8);
@@ -337,8 +364,23 @@ impl PointwiseMap {
             let (fmap_ab, p2p_ba) = refine(&fmaps[0], (basis_a, basis_b), (params, k), cancel)?;
             (fmap_ab, p2p_ba, None)
         };
+        let mut other_p2p_ba = match verdict.as_ref().and_then(Verdict::runner_up) {
+            Some(h) => Some(fmap_to_p2p(
+                verdict.as_ref().expect("a runner-up has a verdict").scores[h]
+                    .fmap_ab
+                    .as_ref(),
+                basis_a.vectors.as_ref(),
+                basis_b.vectors.as_ref(),
+                cancel,
+            )?),
+            None => None,
+        };
+        for map in std::iter::once(&mut p2p_ba).chain(other_p2p_ba.as_mut()) {
+            pin_landmarks(map, &guidance.landmarks);
+        }
         Ok(PointwiseMap {
             p2p_ba,
+            other_p2p_ba,
             fmap_ab,
             verdict,
             timings: PointwiseTimings {
@@ -420,15 +462,29 @@ fn refine(
     }
 }
 
+/// Every landmark of B sent to its partner on A.
+pub fn pin_landmarks(p2p_ba: &mut [u32], landmarks: &[Landmark]) {
+    for &[la, lb] in landmarks {
+        if let Some(image) = p2p_ba.get_mut(lb as usize) {
+            *image = la;
+        }
+    }
+}
+
 /// The hypotheses' functional maps `fmaps` refined by ZoomOut on the same samples and
-/// judged by [`hypotheses::energies`]: the verdict.
+/// judged by [`hypotheses::energies`], then by the shapes' placement and the landmarks
+/// (`guidance`): the verdict. `candidates`: the region groups of each region hypothesis
+/// (the placement's hypothesis comes after them).
+#[allow(clippy::type_complexity)]
 fn verified(
-    side_a: ShapeBasis<'_>,
-    side_b: ShapeBasis<'_>,
-    faces: Option<&hypotheses::OrientedFaces>,
-    kinds: Vec<HypothesisKind>,
+    (side_a, side_b, faces): (
+        ShapeBasis<'_>,
+        ShapeBasis<'_>,
+        Option<&hypotheses::OrientedFaces>,
+    ),
+    (kinds, candidates, regions): (Vec<HypothesisKind>, &[RegionGroups], Option<RegionMatches<'_>>),
     fmaps: &[Mat<f64>],
-    (params, k): (&PointwiseParams, usize),
+    (params, guidance, k): (&PointwiseParams, &Guidance, usize),
     cancel: &Cancel,
 ) -> Result<(Verdict, Option<Vec<u32>>)> {
     let (a, basis_a, basis_b) = (side_a.shape, side_a.basis, side_b.basis);
@@ -457,9 +513,47 @@ fn verified(
         &sample_maps,
         (a.vertices(), basis_a.input_area),
     );
-    // A close call is decided at full resolution, where the meshes' orientation is known.
+    let scale_a = 1.0 / basis_a.input_area.sqrt();
+    for (h, (score, s)) in verdict.scores.iter_mut().zip(&sampled).enumerate() {
+        score.rotation = placement::implied_rotation(
+            a.vertices(),
+            side_b.shape.vertices(),
+            &s.sample_b.vertices,
+            &s.p2p_ba,
+        );
+        score.turn_degrees = placement::turn_degrees(&score.rotation);
+        score.landmark_error = landmark_error(
+            &guidance.landmarks,
+            s.fmap_ab.as_ref(),
+            (phi_a, phi_b),
+            (a.vertices(), scale_a),
+        );
+        score.one_to_one = match (&score.kind, candidates.get(h), regions) {
+            (HypothesisKind::Symmetric, _, _) => Vec::new(),
+            (HypothesisKind::Placement, _, Some(regions)) => hypotheses::one_to_one_from_samples(
+                regions,
+                (Some(&s.sample_b.vertices), &s.sample_b.weights),
+                &s.p2p_ba,
+            ),
+            (_, Some(groups), _) => groups
+                .iter()
+                .filter_map(|(ga, gb)| Some((*ga.first()?, *gb.first()?)))
+                .collect(),
+            _ => Vec::new(),
+        };
+    }
+    if guidance.placement != Placement::Ignore {
+        verdict.apply_placement(guidance.placement);
+    }
+    if !guidance.landmarks.is_empty() {
+        verdict.apply_landmarks();
+    }
+    // A close call is decided at full resolution, where the meshes' orientation is known
+    // (unless the placement or the landmarks decided).
     let mut chosen_map = None;
-    if let (Some(rival), Some(faces)) = (verdict.close_call(), faces) {
+    if let (Some(rival), Some(faces), Decision::Cost) =
+        (verdict.close_call(), faces, verdict.decided_by)
+    {
         cancel.check()?;
         let convert =
             |h: usize| fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel);
@@ -468,12 +562,7 @@ fn verified(
             hypotheses::full_consistency(a, faces, &chosen_p2p),
             hypotheses::full_consistency(a, faces, &rival_p2p),
         );
-        let changed = verdict.settle(
-            rival,
-            consistency,
-            &sample_maps,
-            (a.vertices(), basis_a.input_area),
-        );
+        let changed = verdict.settle(rival, consistency);
         chosen_map = Some(if changed { rival_p2p } else { chosen_p2p });
     }
     Ok((verdict, chosen_map))
@@ -501,7 +590,7 @@ impl SideFeatures {
         basis: &Eigenbasis,
         labels: Option<(&[u32], usize)>,
         sets: &[Vec<u32>],
-        params: &PointwiseParams,
+        (params, landmarks): (&PointwiseParams, &[u32]),
         k: usize,
         with_multiplication: bool,
         oriented_faces: Option<&[[u32; 3]]>,
@@ -562,6 +651,26 @@ impl SideFeatures {
                 features.set_orientation.push(chunk(&orientation, s));
             }
         }
+        if !landmarks.is_empty() {
+            // Each landmark's distance function: the same descriptor on both shapes.
+            let sources = Mat::from_fn(shape.n_vertices(), landmarks.len(), |v, l| {
+                if landmarks[l] as usize == v {
+                    1.0
+                } else {
+                    0.0
+                }
+            });
+            let distances = distance_functions(shape, basis, sources.as_ref());
+            features.point_coef.push(project(
+                basis.vectors.as_ref(),
+                &basis.mass,
+                k,
+                distances.as_ref(),
+            ));
+            let (m, o) = operators(distances.as_ref());
+            features.point_multiplication.extend(m);
+            features.point_orientation.extend(o);
+        }
         let point = [
             params.wks.as_ref().map(|w| wks(basis, w)),
             params.hks.as_ref().map(|h| hks(basis, h)),
@@ -602,7 +711,7 @@ impl Features {
         regions: Option<RegionMatches<'_>>,
         candidates: &[&[(Vec<u32>, Vec<u32>)]],
         orientation_faces: Option<FacePair<'_>>,
-        params: &PointwiseParams,
+        (params, landmarks): (&PointwiseParams, &[Landmark]),
         k: usize,
     ) -> Result<Features> {
         let ShapeBasis {
@@ -630,8 +739,19 @@ impl Features {
             })
             .collect();
         let multiplication = params.descriptor_commutativity > 0.0;
-        let side = |shape, basis, labels, sets: &[Vec<u32>], faces| {
-            SideFeatures::new(shape, basis, labels, sets, params, k, multiplication, faces)
+        let (landmarks_a, landmarks_b): (Vec<u32>, Vec<u32>) =
+            landmarks.iter().map(|&[la, lb]| (la, lb)).unzip();
+        let side = |shape, basis, labels, sets: &[Vec<u32>], landmarks: &[u32], faces| {
+            SideFeatures::new(
+                shape,
+                basis,
+                labels,
+                sets,
+                (params, landmarks),
+                k,
+                multiplication,
+                faces,
+            )
         };
         let labels_a = regions.map(|r| (r.labels_a, r.n_regions_a));
         let labels_b = regions.map(|r| (r.labels_b, r.n_regions_b));
@@ -641,6 +761,7 @@ impl Features {
                 basis_a,
                 labels_a,
                 &sets_a,
+                &landmarks_a,
                 orientation_faces.map(|f| f.0),
             )?,
             b: side(
@@ -648,6 +769,7 @@ impl Features {
                 basis_b,
                 labels_b,
                 &sets_b,
+                &landmarks_b,
                 orientation_faces.map(|f| f.1),
             )?,
             candidates: pairs,

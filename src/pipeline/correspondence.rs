@@ -156,7 +156,7 @@ impl Correspondence {
             estimate: None,
         };
         if params.verify_hypotheses && !params.skip_one_to_one {
-            verify_regions(side_a, side_b, &mut result, progress)?;
+            verify_regions(side_a, side_b, &mut result, &params.guidance(), progress)?;
         }
         result.timings.one_to_one = t.elapsed().as_secs_f64();
         check(progress, Stage::SymmetryBreaking, 1.0)?;
@@ -167,6 +167,17 @@ impl Correspondence {
     /// The confidence of the one-to-one answer in [0, 1] (None when it was not verified).
     pub fn confidence(&self) -> Option<f64> {
         self.verdict.as_ref().map(|v| v.confidence)
+    }
+
+    /// The other answer: the runner-up hypothesis's one-to-one matches with its verdict
+    /// ([`Verdict::other`]; nothing is recomputed). None when no other hypothesis gives a
+    /// different map.
+    pub fn other_answer(&self) -> Option<Correspondence> {
+        let verdict = self.verdict.as_ref()?.other()?;
+        let mut other = self.clone();
+        other.matches_one_to_one = verdict.chosen().one_to_one.clone();
+        other.verdict = Some(verdict);
+        Some(other)
     }
 
     /// The regions and matches as the map stages read them.

@@ -7,7 +7,8 @@
 
 use std::time::Instant;
 
-use crate::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement};
+use crate::maps::landmarks::check_landmarks;
+use crate::maps::pointwise::{pin_landmarks, PointwiseMap, PointwiseParams, Refinement};
 use crate::pipeline::budget::{regions_job, Estimate, Job};
 use crate::pipeline::correspondence::Correspondence;
 use crate::pipeline::multiresolution::{lift_map, lift_regions, working};
@@ -153,6 +154,9 @@ pub fn run_pair(
         PairShapes::Itself(a) => [a, a],
         PairShapes::Ready(a, b) => [a.shape, b.shape],
     };
+    if !matches!(shapes, PairShapes::Itself(_)) {
+        check_landmarks(&job.params.landmarks, a, b)?;
+    }
     let estimate = job.params.budget.check(&job.budget_job([a, b]))?;
     job.params.budget.run(progress, |progress| {
         let started = Instant::now();
@@ -261,26 +265,43 @@ fn on_ready(
         ShapeBasis::new(a.working(), a.basis),
         ShapeBasis::new(b.working(), b.basis),
     );
+    // The landmarks as vertices of the shapes the stages run on.
+    let on_working = |v: u32, proxy: Option<&Proxy>| {
+        proxy.map_or(v, |p| p.location[v as usize].nearest())
+    };
+    let params = Params {
+        landmarks: job
+            .params
+            .landmarks
+            .iter()
+            .map(|&[la, lb]| [on_working(la, a.proxy), on_working(lb, b.proxy)])
+            .collect(),
+        ..job.params.clone()
+    };
     let (mut regions, mut map) = match job.map {
         Some(pointwise) => {
             let (regions, map) =
-                regions_and_map(working_a, working_b, job.params, pointwise, progress)?;
+                regions_and_map(working_a, working_b, &params, pointwise, progress)?;
             (regions, Some(map))
         }
         None => (
-            Correspondence::from_bases(working_a, working_b, job.params, progress)?,
+            Correspondence::from_bases(working_a, working_b, &params, progress)?,
             None,
         ),
     };
     let t = Instant::now();
     lift_regions(&mut regions, [a.proxy, b.proxy]);
     if let Some(map) = &mut map {
-        map.p2p_ba = lift_map(
-            (a.shape, a.proxy),
-            (b.shape, b.proxy),
-            &map.p2p_ba,
-            progress,
-        )?;
+        let lift = |p2p: &[u32], progress: &mut dyn Progress| {
+            lift_map((a.shape, a.proxy), (b.shape, b.proxy), p2p, progress)
+        };
+        map.p2p_ba = lift(&map.p2p_ba, progress)?;
+        if let Some(other) = &map.other_p2p_ba {
+            map.other_p2p_ba = Some(lift(other, progress)?);
+        }
+        for p2p in std::iter::once(&mut map.p2p_ba).chain(map.other_p2p_ba.as_mut()) {
+            pin_landmarks(p2p, &job.params.landmarks);
+        }
     }
     let proxies_s = if a.proxy.is_some() || b.proxy.is_some() {
         t.elapsed().as_secs_f64()

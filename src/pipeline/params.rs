@@ -2,6 +2,8 @@
 //! measurement: docs/decisions.md). The command line, the C API and the add-ons read their
 //! defaults from here.
 
+use crate::maps::landmarks::Landmark;
+use crate::maps::placement::{Guidance, Placement};
 use crate::pipeline::budget::Budget;
 use crate::pipeline::multiresolution::Multiresolution;
 use crate::regions::matching::MatchingParams;
@@ -47,6 +49,13 @@ pub struct Params {
     /// The job's memory ceiling and time limit, checked from an estimate before any work
     /// and the time limit enforced while it runs ([`crate::pipeline::budget`]).
     pub budget: Budget,
+    /// How the shapes' placement in space is used to choose among the verified hypotheses
+    /// (docs/placement.md): `Auto` only when it is informative.
+    pub placement: Placement,
+    /// Pairs of vertices known to correspond (A's vertex, B's vertex; input indices), 0 to
+    /// [`crate::maps::landmarks::MAX_LANDMARKS`] ([`crate::maps::landmarks`]). Checked
+    /// against the shapes when the job starts.
+    pub landmarks: Vec<Landmark>,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -73,12 +82,22 @@ impl Default for Params {
             verify_hypotheses: true,
             multiresolution: Multiresolution::default(),
             budget: Budget::default(),
+            placement: Placement::Auto,
+            landmarks: Vec::new(),
             non_exhaustive: crate::NonExhaustive(()),
         }
     }
 }
 
 impl Params {
+    /// What the user knows beyond the shapes' geometry, for the map stages.
+    pub fn guidance(&self) -> Guidance {
+        Guidance {
+            placement: self.placement,
+            landmarks: self.landmarks.clone(),
+        }
+    }
+
     /// Checks every parameter's range before any work starts, so a bad value fails at once
     /// with [`crate::Error::InvalidParameter`] instead of after the eigensolver.
     pub fn validate(&self) -> Result<()> {

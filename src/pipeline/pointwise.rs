@@ -3,6 +3,7 @@
 
 use crate::maps::fmap::ZoomOutParams;
 use crate::maps::hypotheses::{self, Verdict};
+use crate::maps::placement::Guidance;
 use crate::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement};
 use crate::pipeline::budget::Estimate;
 use crate::pipeline::correspondence::Correspondence;
@@ -107,6 +108,21 @@ impl PointwiseCorrespondence {
     pub fn confidence(&self) -> Option<f64> {
         self.verdict().map(|v| v.confidence)
     }
+
+    /// The other answer: the runner-up hypothesis's map and one-to-one regions, with its
+    /// verdict ([`Verdict::other`]), computed with this one (nothing is recomputed). None
+    /// when no other hypothesis gives a different map.
+    pub fn other_answer(&self) -> Option<PointwiseCorrespondence> {
+        let verdict = self.map.verdict.as_ref()?.other()?;
+        let p2p_ba = self.map.other_p2p_ba.clone()?;
+        let mut other = self.clone();
+        other.map.other_p2p_ba = Some(std::mem::replace(&mut other.map.p2p_ba, p2p_ba));
+        other.map.fmap_ab = verdict.chosen().fmap_ab.clone();
+        other.regions.matches_one_to_one = verdict.chosen().one_to_one.clone();
+        other.regions.verdict = Some(verdict.clone());
+        other.map.verdict = Some(verdict);
+        Some(other)
+    }
 }
 
 /// The eigensolver's parameters of a pointwise job: enough eigenpairs for the map and the
@@ -148,7 +164,14 @@ pub fn regions_and_map(
         orientation: pointwise.orientation && params.verify_hypotheses,
         ..pointwise.clone()
     };
-    let map = PointwiseMap::from_bases(a, b, Some(regions.matches_view()), &pointwise, progress)?;
+    let map = PointwiseMap::guided(
+        a,
+        b,
+        Some(regions.matches_view()),
+        &pointwise,
+        &params.guidance(),
+        progress,
+    )?;
     if let Some(verdict) = &map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);
@@ -167,6 +190,7 @@ pub fn verify_regions(
     a: ShapeBasis<'_>,
     b: ShapeBasis<'_>,
     regions: &mut Correspondence,
+    guidance: &Guidance,
     progress: &mut dyn Progress,
 ) -> Result<()> {
     if regions.matches_one_to_one.is_empty() {
@@ -187,7 +211,14 @@ pub fn verify_regions(
         inner: progress,
         stage: Stage::SymmetryBreaking,
     };
-    let map = PointwiseMap::from_bases(a, b, Some(regions.matches_view()), &params, &mut as_stage)?;
+    let map = PointwiseMap::guided(
+        a,
+        b,
+        Some(regions.matches_view()),
+        &params,
+        guidance,
+        &mut as_stage,
+    )?;
     if let Some(verdict) = map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);

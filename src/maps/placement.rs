@@ -1,0 +1,247 @@
+//! Where the shapes stand (docs/placement.md): the rigid turn each verified hypothesis
+//! implies between the two shapes' frames, whether that frame is informative, and a
+//! hypothesis made from the frame itself (each vertex of B sent to the nearest point of A
+//! after both are centred and scaled to unit area, as Smooth Shells starts from the
+//! product of spectral and spatial coordinates).
+//!
+//! A human body is nearly symmetric under a half-turn (front and back swapped together with
+//! left and right): no intrinsic energy separates the two maps, but the two shapes' frames
+//! usually do. Shapes turned at random must give the intrinsic answer, so the frame is used
+//! only when one competitive hypothesis implies almost no turn and every other answer a
+//! large one ([`Placement::Auto`]).
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::shape::neighbors::PointTree;
+use crate::shape::Shape;
+
+/// How the two shapes' placement in space is used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Placement {
+    /// Used when it is informative (one competitive answer implies at most
+    /// [`NEAR_TURN`] degrees of turn and every other answer at least [`FAR_TURN`]);
+    /// otherwise ignored.
+    #[default]
+    Auto,
+    /// Never used: the answer depends on the shapes' intrinsic geometry only.
+    Ignore,
+    /// The shapes stand alike (one scene, one scanner rig): the competitive answer that
+    /// implies the least turn is taken.
+    Trust,
+}
+
+/// What the user knows beyond the shapes' geometry: how to use where they stand, and
+/// landmark pairs (vertices of the shapes a function is given, A's then B's).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Guidance {
+    /// How the shapes' placement is used.
+    pub placement: Placement,
+    /// Landmark pairs ([`crate::maps::landmarks`]).
+    pub landmarks: Vec<crate::maps::landmarks::Landmark>,
+}
+
+/// The names of [`Placement`]'s values, by value (0, 1, 2).
+pub const PLACEMENT_NAMES: [&str; 3] = ["auto", "ignore", "trust"];
+
+impl Placement {
+    /// Every value, in the order of [`PLACEMENT_NAMES`].
+    pub const ALL: [Placement; 3] = [Placement::Auto, Placement::Ignore, Placement::Trust];
+
+    /// `auto`, `ignore` or `trust`.
+    pub fn name(self) -> &'static str {
+        PLACEMENT_NAMES[self as usize]
+    }
+}
+
+/// A turn of at most this many degrees is "no turn" for [`Placement::Auto`]. Measured on
+/// the development pairs (docs/placement.md): the true maps of pairs in one frame imply
+/// 0-25 degrees (poses differ), a half-turn 150-180; shapes turned at random land within
+/// 30 degrees of no turn with probability 0.75% per answer.
+pub const NEAR_TURN: f64 = 30.0;
+
+/// Every other answer must imply at least this many degrees for the frame to be
+/// informative: answers between [`NEAR_TURN`] and this leave the frame undecided.
+pub const FAR_TURN: f64 = 100.0;
+
+/// A hypothesis the frame picks must cost at most this many times the cheapest one: the
+/// frame chooses among consistent answers, it does not rescue a poor map.
+pub const PLACEMENT_COST_RATIO: f64 = 3.0;
+
+/// The proper rotation `R` that best sends `from` onto `to` (`to[i] ~ R from[i] + t`, least
+/// squares; Kabsch's method), as rows.
+pub fn best_rotation(from: &[[f64; 3]], to: &[[f64; 3]]) -> [[f64; 3]; 3] {
+    let n = from.len().min(to.len()).max(1) as f64;
+    let centroid = |p: &[[f64; 3]]| {
+        p.iter()
+            .fold(Vector3::zeros(), |s, x| s + Vector3::from(*x))
+            / n
+    };
+    let (cf, ct) = (centroid(from), centroid(to));
+    let mut h = Matrix3::<f64>::zeros();
+    for (p, q) in from.iter().zip(to) {
+        h += (Vector3::from(*q) - ct) * (Vector3::from(*p) - cf).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    };
+    let d = (u * v_t).determinant().signum();
+    let r = u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, if d == 0.0 { 1.0 } else { d })) * v_t;
+    std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]))
+}
+
+/// The angle of a rotation, in degrees (0 to 180).
+pub fn turn_degrees(r: &[[f64; 3]; 3]) -> f64 {
+    let trace = r[0][0] + r[1][1] + r[2][2];
+    ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// The rotation a map implies: B's points `vertices_b` (rows `samples_b`) onto their images
+/// `p2p` (vertices of A).
+pub fn implied_rotation(
+    vertices_a: &[[f64; 3]],
+    vertices_b: &[[f64; 3]],
+    samples_b: &[u32],
+    p2p: &[u32],
+) -> [[f64; 3]; 3] {
+    let from: Vec<[f64; 3]> = samples_b.iter().map(|&v| vertices_b[v as usize]).collect();
+    let to: Vec<[f64; 3]> = p2p.iter().map(|&x| vertices_a[x as usize]).collect();
+    best_rotation(&from, &to)
+}
+
+/// The hypothesis the frame picks among `turns` (degrees) and `costs`, where `eligible(h)`
+/// says which may be picked (definite hypotheses) and `different(h, g)` whether two give
+/// different maps. `Auto`: the cheapest eligible hypothesis within [`NEAR_TURN`], when it
+/// costs at most [`PLACEMENT_COST_RATIO`] times the cheapest of all and every hypothesis
+/// whose map differs from it implies at least [`FAR_TURN`] or also lies within
+/// [`NEAR_TURN`] (then the cheaper of those is the pick). `Trust`: the eligible hypothesis of
+/// least turn within the cost ratio. `Ignore`: none.
+pub fn frame_pick(
+    mode: Placement,
+    turns: &[f64],
+    costs: &[f64],
+    eligible: &dyn Fn(usize) -> bool,
+    different: &dyn Fn(usize, usize) -> bool,
+) -> Option<usize> {
+    let cheapest = costs.iter().copied().fold(f64::INFINITY, f64::min);
+    let competitive = |h: usize| eligible(h) && costs[h] <= PLACEMENT_COST_RATIO * cheapest;
+    let n = turns.len();
+    match mode {
+        Placement::Ignore => None,
+        Placement::Trust => (0..n)
+            .filter(|&h| competitive(h))
+            .min_by(|&x, &y| turns[x].total_cmp(&turns[y]).then(x.cmp(&y))),
+        Placement::Auto => {
+            let pick = (0..n)
+                .filter(|&h| competitive(h) && turns[h] <= NEAR_TURN)
+                .min_by(|&x, &y| costs[x].total_cmp(&costs[y]).then(x.cmp(&y)))?;
+            let undecided = (0..n).any(|h| {
+                different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN
+            });
+            (!undecided).then_some(pick)
+        }
+    }
+}
+
+/// The map the frame gives: every vertex of B to the nearest active vertex of A, both
+/// centred on their area-weighted centroid and scaled to unit area (`mass_*`: the vertex
+/// masses; `area_*`: the shapes' areas).
+pub fn nearest_in_frame(
+    (a, mass_a, area_a): (&Shape, &[f64], f64),
+    (b, mass_b, area_b): (&Shape, &[f64], f64),
+) -> Vec<u32> {
+    let normalised = |shape: &Shape, mass: &[f64], area: f64| -> Vec<[f64; 3]> {
+        let total: f64 = mass.iter().sum::<f64>().max(1e-300);
+        let mut c = [0.0; 3];
+        for (p, m) in shape.vertices().iter().zip(mass) {
+            for k in 0..3 {
+                c[k] += p[k] * m / total;
+            }
+        }
+        let s = 1.0 / area.max(1e-300).sqrt();
+        shape
+            .vertices()
+            .iter()
+            .map(|p| std::array::from_fn(|k| (p[k] - c[k]) * s))
+            .collect()
+    };
+    let (va, vb) = (
+        normalised(a, mass_a, area_a),
+        normalised(b, mass_b, area_b),
+    );
+    let active = a.active_vertices();
+    let tree = PointTree::new(&active.iter().map(|&v| va[v as usize]).collect::<Vec<_>>());
+    vb.iter().map(|p| active[tree.nearest(p)]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rotation_z(degrees: f64) -> [[f64; 3]; 3] {
+        let (s, c) = degrees.to_radians().sin_cos();
+        [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    }
+
+    fn apply(r: &[[f64; 3]; 3], p: &[f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|i| (0..3).map(|j| r[i][j] * p[j]).sum())
+    }
+
+    #[test]
+    fn the_best_rotation_recovers_a_turn() {
+        let points: Vec<[f64; 3]> = (0..50)
+            .map(|i| {
+                let t = i as f64;
+                [t.sin() * 2.0, (t * 0.7).cos(), (t * 0.3).sin() * 0.5 + t * 0.01]
+            })
+            .collect();
+        for degrees in [0.0, 20.0, 90.0, 179.0] {
+            let r = rotation_z(degrees);
+            let turned: Vec<[f64; 3]> = points
+                .iter()
+                .map(|p| {
+                    let q = apply(&r, p);
+                    [q[0] + 5.0, q[1] - 1.0, q[2]]
+                })
+                .collect();
+            let found = best_rotation(&points, &turned);
+            assert!((turn_degrees(&found) - degrees).abs() < 1e-6, "{degrees}");
+        }
+    }
+
+    #[test]
+    fn auto_uses_the_frame_only_when_it_separates_the_answers() {
+        let yes = |_: usize| true;
+        let differ = |h: usize, g: usize| h != g;
+        let costs = [1.0, 1.1, 1.2];
+        // The cheapest answer is half-turned, a near-identity rival within the cost ratio.
+        assert_eq!(
+            frame_pick(Placement::Auto, &[178.0, 5.0, 160.0], &costs, &yes, &differ),
+            Some(1)
+        );
+        // An answer between the two thresholds: undecided.
+        assert_eq!(
+            frame_pick(Placement::Auto, &[60.0, 5.0, 160.0], &costs, &yes, &differ),
+            None
+        );
+        // No answer near no turn (shapes turned at random): nothing.
+        assert_eq!(
+            frame_pick(Placement::Auto, &[120.0, 140.0, 160.0], &costs, &yes, &differ),
+            None
+        );
+        // Too costly to be picked.
+        assert_eq!(
+            frame_pick(Placement::Auto, &[178.0, 5.0], &[1.0, 3.5], &yes, &differ),
+            None
+        );
+        assert_eq!(
+            frame_pick(Placement::Trust, &[120.0, 60.0, 160.0], &costs, &yes, &differ),
+            Some(1)
+        );
+        assert_eq!(
+            frame_pick(Placement::Ignore, &[178.0, 5.0, 160.0], &costs, &yes, &differ),
+            None
+        );
+    }
+}
