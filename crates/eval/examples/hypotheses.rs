@@ -11,7 +11,13 @@
 //!         [--data DIR] [--limit N] [--cache DIR] [--reverse] DATASET ...
 //!
 //! `--reverse` also runs every pair the other way (B to A), for the direction test;
-//! `--region-basis` verifies on the regions' basis (50 eigenpairs, ZoomOut to 50).
+//! `--region-basis` verifies on the regions' basis (50 eigenpairs, ZoomOut to 50);
+//! `--placement auto|ignore|trust` sets how the shapes' placement is used (default auto);
+//! `--rotate SEED` turns B by a random rotation (seeded per pair) before matching;
+//! `--landmarks N` gives N landmark pairs from the ground truth: B's vertices spread by
+//! farthest-point sampling from the truth's vertex farthest from B's centroid, with their
+//! true partners. Each line also has the hypothesis's implied turn (degrees) and rotation,
+//! its landmark error and what decided the choice.
 
 use std::path::PathBuf;
 
@@ -30,6 +36,8 @@ fn main() -> shapecorr::Result<()> {
     let mut args = std::env::args().skip(1);
     let (mut data, mut limit, mut cache, mut reverse) = (default_data_root(), None, None, false);
     let mut region_basis = false;
+    let mut placement = shapecorr::maps::placement::Placement::Auto;
+    let (mut rotate, mut n_landmarks) = (None::<u64>, 0usize);
     let mut datasets = Vec::new();
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -38,10 +46,22 @@ fn main() -> shapecorr::Result<()> {
             "--cache" => cache = args.next().map(PathBuf::from),
             "--reverse" => reverse = true,
             "--region-basis" => region_basis = true,
+            "--placement" => {
+                let name = args.next().expect("--placement auto|ignore|trust");
+                placement = shapecorr::maps::placement::Placement::ALL
+                    .into_iter()
+                    .find(|p| p.name() == name)
+                    .expect("--placement auto|ignore|trust");
+            }
+            "--rotate" => rotate = args.next().and_then(|n| n.parse().ok()),
+            "--landmarks" => n_landmarks = args.next().and_then(|n| n.parse().ok()).unwrap_or(0),
             name => datasets.push(name.to_string()),
         }
     }
-    let params = Params::default();
+    let params = Params {
+        placement,
+        ..Params::default()
+    };
     let mut pointwise = PointwiseParams::default();
     if region_basis {
         // The verification on the regions' own basis (50 eigenpairs, ZoomOut to 50).
@@ -76,7 +96,13 @@ fn main() -> shapecorr::Result<()> {
                 });
             }
             for run in runs {
-                if let Err(e) = one_pair(&mut store, &name, &run, &params, &pointwise) {
+                if let Err(e) = one_pair(
+                    &mut store,
+                    &name,
+                    &run,
+                    (&params, &pointwise),
+                    (rotate, n_landmarks),
+                ) {
                     eprintln!("{name} {} -> {}: {e}", run.source, run.target);
                 }
             }
@@ -89,15 +115,37 @@ fn one_pair(
     store: &mut ShapeStore,
     name: &str,
     pair: &Pair,
-    params: &Params,
-    pointwise: &PointwiseParams,
+    (params, pointwise): (&Params, &PointwiseParams),
+    (rotate, n_landmarks): (Option<u64>, usize),
 ) -> shapecorr::Result<()> {
     store.load(&pair.source, true, true)?;
     store.load(&pair.target, true, false)?;
-    let (a, b) = (
-        &store.get(&pair.source).shape,
-        &store.get(&pair.target).shape,
-    );
+    let a = &store.get(&pair.source).shape;
+    let b_given = store.get(&pair.target).shape.clone();
+    let b = &match rotate {
+        Some(seed) => {
+            let r = random_rotation(seed ^ fnv(&format!("{}>{}", pair.source, pair.target)));
+            b_given.with_vertices(
+                b_given
+                    .vertices()
+                    .iter()
+                    .map(|p| std::array::from_fn(|i| (0..3).map(|j| r[i][j] * p[j]).sum()))
+                    .collect(),
+            )?
+        }
+        None => b_given,
+    };
+    let mut params = params.clone();
+    if n_landmarks > 0 {
+        let (truth, _) = store.dataset.ground_truth(
+            &pair.source,
+            &pair.target,
+            a.n_vertices(),
+            b.n_vertices(),
+        )?;
+        params.landmarks = landmarks_from_truth(b.vertices(), &truth, n_landmarks);
+    }
+    let params = &params;
     let (basis_a, basis_b) = (
         &store.basis(&pair.source).basis,
         &store.basis(&pair.target).basis,
@@ -162,17 +210,34 @@ fn one_pair(
         })
         .collect();
     maps.push(("final".into(), map.p2p_ba.clone(), 0.0));
+    if let Some(other) = &map.other_p2p_ba {
+        maps.push(("other".into(), other.clone(), 0.0));
+    }
+    for &[la, lb] in &params.landmarks {
+        if map.p2p_ba[lb as usize] != la {
+            eprintln!("landmark ({la}, {lb}) not kept: {}", map.p2p_ba[lb as usize]);
+        }
+    }
     let scores = score_maps(store, pair, &maps, 1000)?;
-    let final_error = scores.last().map_or(f64::NAN, |s| s.error.mean);
+    let n_h = verdict.scores.len();
+    let final_error = scores.get(n_h).map_or(f64::NAN, |s| s.error.mean);
+    let other_error = scores.get(n_h + 1).map(|s| s.error.mean);
     let mut summary = String::new();
     for (i, (h, s)) in verdict.scores.iter().zip(&scores).enumerate() {
         let e = &h.energy;
         println!(
-            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"orient_full\":{:.4},\"cover_full\":{:.4},\"dist\":{:?},\"seconds\":{seconds:.3}}}",
+            "{{\"dataset\":\"{name}\",\"source\":\"{}\",\"target\":\"{}\",\"hypothesis\":\"{}\",\"chosen\":{},\"turn\":{:.2},\"rotation\":{:?},\"landmark_error\":{},\"decided_by\":\"{}\",\"ruled_out\":{},\"runner_up\":{},\"other_error\":{},\"distortion\":{:.6},\"coverage\":{:.5},\"orientation\":{},\"cost\":{:.6},\"residual\":{:.6},\"error\":{:.5},\"error_flip\":{:.5},\"confidence\":{:.4},\"final_error\":{final_error:.5},\"distance_to_chosen\":{:.4},\"orient_full\":{:.4},\"cover_full\":{:.4},\"dist\":{:?},\"seconds\":{seconds:.3}}}",
             pair.source,
             pair.target,
             h.kind.name(),
             i == verdict.chosen,
+            h.turn_degrees,
+            h.rotation,
+            h.landmark_error.map_or("null".to_string(), |x| format!("{x:.4}")),
+            verdict.decided_by.name(),
+            verdict.ruled_out[i],
+            verdict.runner_up() == Some(i),
+            other_error.map_or("null".to_string(), |x| format!("{x:.5}")),
             e.distortion,
             e.coverage,
             e.orientation.map_or("null".to_string(), |o| format!("{o:.5}")),
@@ -207,4 +272,63 @@ fn spread(pairs: &[Pair], n: Option<usize>) -> Vec<Pair> {
         Some(n) if n < pairs.len() => (0..n).map(|i| pairs[i * pairs.len() / n].clone()).collect(),
         _ => pairs.to_vec(),
     }
+}
+
+/// A rotation drawn uniformly (a normalised random quaternion), from `seed`.
+fn random_rotation(seed: u64) -> [[f64; 3]; 3] {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let gauss = |rng: &mut rand_chacha::ChaCha8Rng| {
+        let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    let q: [f64; 4] = std::array::from_fn(|_| gauss(&mut rng));
+    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let [w, x, y, z] = q.map(|c| c / n);
+    [
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
+    ]
+}
+
+/// FNV-1a of a text: a per-pair seed that does not depend on the run.
+fn fnv(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// `n` landmark pairs from the ground truth `truth` ((A vertex, B vertex) pairs): B's
+/// vertices spread by farthest-point sampling (Euclidean), starting from the one farthest
+/// from B's centroid.
+fn landmarks_from_truth(vertices_b: &[[f64; 3]], truth: &[(u32, u32)], n: usize) -> Vec<[u32; 2]> {
+    let mut seen = std::collections::HashSet::new();
+    let pairs: Vec<(u32, u32)> = truth.iter().copied().filter(|p| seen.insert(p.1)).collect();
+    if pairs.is_empty() {
+        return Vec::new();
+    }
+    let at = |p: &(u32, u32)| vertices_b[p.1 as usize];
+    let c: [f64; 3] = std::array::from_fn(|k| {
+        pairs.iter().map(|p| at(p)[k]).sum::<f64>() / pairs.len() as f64
+    });
+    let d2 = |x: [f64; 3], y: [f64; 3]| (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>();
+    let far = |from: &dyn Fn(usize) -> f64| {
+        (0..pairs.len()).fold(0, |best, i| if from(i) > from(best) { i } else { best })
+    };
+    let mut chosen = vec![far(&|i| d2(at(&pairs[i]), c))];
+    let mut nearest: Vec<f64> = pairs.iter().map(|p| d2(at(p), at(&pairs[chosen[0]]))).collect();
+    while chosen.len() < n.min(pairs.len()) {
+        let next = far(&|i| nearest[i]);
+        chosen.push(next);
+        for (i, p) in pairs.iter().enumerate() {
+            nearest[i] = nearest[i].min(d2(at(p), at(&pairs[next])));
+        }
+    }
+    let mut used_a = std::collections::HashSet::new();
+    chosen
+        .into_iter()
+        .map(|i| [pairs[i].0, pairs[i].1])
+        .filter(|l| used_a.insert(l[0]))
+        .collect()
 }

@@ -16,6 +16,7 @@ use crate::bench_store::{BasisCache, ResultLog, ShapeStore};
 use crate::datasets::{discover, Pair};
 use crate::tails::{error_tails_table, Tails, FAILED_ERRORS};
 use shapecorr::evaluation::score_correspondence;
+use shapecorr::maps::placement::Placement;
 use shapecorr::maps::pointwise::PointwiseParams;
 use shapecorr::pipeline::pointwise::regions_and_map;
 use shapecorr::pipeline::Params;
@@ -41,19 +42,25 @@ pub struct TailRecord {
     pub confidence: Option<f64>,
     /// The chosen hypothesis.
     pub hypothesis: Option<String>,
+    /// What settled the choice (`cost`, `close call`, `placement`, `landmarks`).
+    #[serde(default)]
+    pub decided_by: Option<String>,
+    /// The turn (degrees) the chosen map implies between B's frame and A's.
+    #[serde(default)]
+    pub turn_degrees: Option<f64>,
     /// Seconds of the regions and the map (eigenbases not counted: cached).
     pub seconds: f64,
 }
 
 /// Runs every pair of every dataset under `root` (or of `only`), resuming from
 /// `work/tails.jsonl`; returns the records. Dense shapes run on proxies as the library's
-/// default does, unless `full_resolution`.
+/// default does, unless `full_resolution`; the shapes' placement is used as `placement` says.
 pub fn run_tails(
     root: &Path,
     work: &Path,
     only: Option<&[String]>,
     samples: usize,
-    full_resolution: bool,
+    (full_resolution, placement): (bool, Placement),
 ) -> Result<Vec<TailRecord>> {
     let (mut datasets, _) = discover(root)?;
     if let Some(only) = only {
@@ -61,7 +68,10 @@ pub fn run_tails(
     }
     std::fs::create_dir_all(work).map_err(|e| shapecorr::Error::file(work, e.to_string()))?;
     let (mut log, mut records) = ResultLog::open::<TailRecord>(&work.join("tails.jsonl"))?;
-    let mut params = Params::default();
+    let mut params = Params {
+        placement,
+        ..Params::default()
+    };
     if full_resolution {
         params.multiresolution.above = 0;
     }
@@ -155,6 +165,8 @@ fn tail_pair(
     let verdict = map.verdict.as_ref().or(regions.verdict.as_ref());
     let confidence = verdict.map(|v| v.confidence);
     let hypothesis = verdict.map(|v| v.chosen().kind.name());
+    let decided_by = verdict.map(|v| v.decided_by.name().to_string());
+    let turn_degrees = verdict.map(|v| v.chosen().turn_degrees);
     let scores = score_maps(store, pair, &[("map".into(), map.p2p_ba, 0.0)], samples)?;
     Ok(TailRecord {
         dataset: name.to_string(),
@@ -167,6 +179,8 @@ fn tail_pair(
         error_flip_ok: scores[0].error_mirrored.map(|_| scores[0].best_mean()),
         confidence,
         hypothesis,
+        decided_by,
+        turn_degrees,
         seconds,
     })
 }
@@ -255,19 +269,21 @@ pub fn tails_page(records: &[TailRecord], command: &str) -> String {
     } else {
         let _ = writeln!(
             s,
-            "| dataset | pair | error | symmetric | one-to-one | hypothesis | confidence |"
+            "| dataset | pair | error | symmetric | one-to-one | hypothesis | decided by | turn | confidence |"
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
         for r in failed {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.4} | {:.3} | {:.3} | {} | {} |",
+                "| {} | {} | {:.4} | {:.3} | {:.3} | {} | {} | {} | {} |",
                 r.dataset,
                 name(r),
                 r.error,
                 r.symmetric,
                 r.one_to_one,
                 r.hypothesis.as_deref().unwrap_or("-"),
+                r.decided_by.as_deref().unwrap_or("-"),
+                r.turn_degrees.map_or("-".into(), |t| format!("{t:.0}")),
                 r.confidence.map_or("-".into(), |c| format!("{c:.2}"))
             );
         }

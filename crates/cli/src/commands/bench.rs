@@ -414,18 +414,32 @@ pub struct BenchTailsArgs {
     /// multiresolution path is compared with).
     #[arg(long)]
     full_resolution: bool,
+    /// How the shapes' placement is used: auto (the default), ignore (the intrinsic
+    /// figures, comparable with the literature) or trust.
+    #[arg(long, default_value = "auto")]
+    placement: String,
 }
 
 impl BenchTailsArgs {
     pub fn run(&self) -> Result<(), Error> {
+        let placement = shapecorr::maps::placement::Placement::ALL
+            .into_iter()
+            .find(|p| p.name() == self.placement)
+            .ok_or_else(|| Error::InvalidParameter {
+                name: "placement",
+                reason: format!("expected auto, ignore or trust, got {}", self.placement),
+            })?;
         let records = shapecorr_eval::bench_tails::run_tails(
             &data_root(&self.data),
             &self.work,
             self.datasets.as_deref(),
             self.samples,
-            self.full_resolution,
+            (self.full_resolution, placement),
         )?;
         let mut command = "shapecorr bench tails".to_string();
+        if placement != shapecorr::maps::placement::Placement::Auto {
+            command.push_str(&format!(" --placement {}", placement.name()));
+        }
         if self.full_resolution {
             command.push_str(" --full-resolution");
         }
