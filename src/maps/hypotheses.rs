@@ -192,6 +192,16 @@ impl Verdict {
             .filter(|s| s.distance_to_chosen > DIFFERENT_MAP)
             .min_by(|x, y| x.energy.cost().total_cmp(&y.energy.cost()));
         Some(match rival {
+            Some(r) if self.decided_by == Decision::OtherAnswer && r.energy.cost() < best => {
+                format!(
+                    "the other answer was taken (confidence {:.2}): its {} hypothesis costs {:.3}, the {} hypothesis chosen first {:.3}",
+                    self.confidence,
+                    self.chosen().kind.name(),
+                    best,
+                    r.kind.name(),
+                    r.energy.cost()
+                )
+            }
             Some(r) if r.energy.cost() < best * (1.0 + MARGIN_SCALE) => format!(
                 "doubtful correspondence (confidence {:.2}): the {} hypothesis is almost as consistent as the chosen {} and gives a different map (parts may be swapped or mirrored)",
                 self.confidence,

@@ -93,7 +93,8 @@ pub fn best_rotation(from: &[[f64; 3]], to: &[[f64; 3]]) -> [[f64; 3]; 3] {
         return [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     };
     let d = (u * v_t).determinant().signum();
-    let r = u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, if d == 0.0 { 1.0 } else { d })) * v_t;
+    let r =
+        u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, if d == 0.0 { 1.0 } else { d })) * v_t;
     std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]))
 }
 
@@ -121,8 +122,9 @@ pub fn implied_rotation(
 /// different maps. `Auto`: the cheapest eligible hypothesis within [`NEAR_TURN`], when it
 /// costs at most [`PLACEMENT_COST_RATIO`] times the cheapest of all and every hypothesis
 /// whose map differs from it implies at least [`FAR_TURN`] or also lies within
-/// [`NEAR_TURN`] (then the cheaper of those is the pick). `Trust`: the eligible hypothesis of
-/// least turn within the cost ratio. `Ignore`: none.
+/// [`NEAR_TURN`] (then the cheaper of those is the pick). `Trust`: among the eligible
+/// hypotheses within the cost ratio, the cheapest within [`NEAR_TURN`] of the least turn.
+/// `Ignore`: none.
 pub fn frame_pick(
     mode: Placement,
     turns: &[f64],
@@ -135,16 +137,22 @@ pub fn frame_pick(
     let n = turns.len();
     match mode {
         Placement::Ignore => None,
-        Placement::Trust => (0..n)
-            .filter(|&h| competitive(h))
-            .min_by(|&x, &y| turns[x].total_cmp(&turns[y]).then(x.cmp(&y))),
+        Placement::Trust => {
+            // The least turn, and among the answers within NEAR_TURN of it the cheapest.
+            let least = (0..n)
+                .filter(|&h| competitive(h))
+                .map(|h| turns[h])
+                .fold(f64::INFINITY, f64::min);
+            (0..n)
+                .filter(|&h| competitive(h) && turns[h] <= least + NEAR_TURN)
+                .min_by(|&x, &y| costs[x].total_cmp(&costs[y]).then(x.cmp(&y)))
+        }
         Placement::Auto => {
             let pick = (0..n)
                 .filter(|&h| competitive(h) && turns[h] <= NEAR_TURN)
                 .min_by(|&x, &y| costs[x].total_cmp(&costs[y]).then(x.cmp(&y)))?;
-            let undecided = (0..n).any(|h| {
-                different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN
-            });
+            let undecided =
+                (0..n).any(|h| different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN);
             (!undecided).then_some(pick)
         }
     }
@@ -172,10 +180,7 @@ pub fn nearest_in_frame(
             .map(|p| std::array::from_fn(|k| (p[k] - c[k]) * s))
             .collect()
     };
-    let (va, vb) = (
-        normalised(a, mass_a, area_a),
-        normalised(b, mass_b, area_b),
-    );
+    let (va, vb) = (normalised(a, mass_a, area_a), normalised(b, mass_b, area_b));
     let active = a.active_vertices();
     let tree = PointTree::new(&active.iter().map(|&v| va[v as usize]).collect::<Vec<_>>());
     vb.iter().map(|p| active[tree.nearest(p)]).collect()
@@ -199,7 +204,11 @@ mod tests {
         let points: Vec<[f64; 3]> = (0..50)
             .map(|i| {
                 let t = i as f64;
-                [t.sin() * 2.0, (t * 0.7).cos(), (t * 0.3).sin() * 0.5 + t * 0.01]
+                [
+                    t.sin() * 2.0,
+                    (t * 0.7).cos(),
+                    (t * 0.3).sin() * 0.5 + t * 0.01,
+                ]
             })
             .collect();
         for degrees in [0.0, 20.0, 90.0, 179.0] {
@@ -233,7 +242,13 @@ mod tests {
         );
         // No answer near no turn (shapes turned at random): nothing.
         assert_eq!(
-            frame_pick(Placement::Auto, &[120.0, 140.0, 160.0], &costs, &yes, &differ),
+            frame_pick(
+                Placement::Auto,
+                &[120.0, 140.0, 160.0],
+                &costs,
+                &yes,
+                &differ
+            ),
             None
         );
         // Too costly to be picked.
@@ -242,11 +257,28 @@ mod tests {
             None
         );
         assert_eq!(
-            frame_pick(Placement::Trust, &[120.0, 60.0, 160.0], &costs, &yes, &differ),
+            frame_pick(
+                Placement::Trust,
+                &[120.0, 60.0, 160.0],
+                &costs,
+                &yes,
+                &differ
+            ),
             Some(1)
         );
+        // Trust: two answers of about the same least turn, the cheaper one.
         assert_eq!(
-            frame_pick(Placement::Ignore, &[178.0, 5.0, 160.0], &costs, &yes, &differ),
+            frame_pick(Placement::Trust, &[9.0, 8.0, 160.0], &costs, &yes, &differ),
+            Some(0)
+        );
+        assert_eq!(
+            frame_pick(
+                Placement::Ignore,
+                &[178.0, 5.0, 160.0],
+                &costs,
+                &yes,
+                &differ
+            ),
             None
         );
     }

@@ -12,8 +12,8 @@ use faer::Mat;
 use rayon::prelude::*;
 
 use crate::maps::fmap::{
-    fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, p2p_to_fmap,
-    project, solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
+    fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, p2p_to_fmap, project,
+    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
 };
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, Decision, HypothesisKind, RegionGroups, Verdict};
@@ -482,7 +482,11 @@ fn verified(
         ShapeBasis<'_>,
         Option<&hypotheses::OrientedFaces>,
     ),
-    (kinds, candidates, regions): (Vec<HypothesisKind>, &[RegionGroups], Option<RegionMatches<'_>>),
+    (kinds, candidates, regions): (
+        Vec<HypothesisKind>,
+        &[RegionGroups],
+        Option<RegionMatches<'_>>,
+    ),
     fmaps: &[Mat<f64>],
     (params, guidance, k): (&PointwiseParams, &Guidance, usize),
     cancel: &Cancel,

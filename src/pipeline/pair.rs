@@ -266,9 +266,8 @@ fn on_ready(
         ShapeBasis::new(b.working(), b.basis),
     );
     // The landmarks as vertices of the shapes the stages run on.
-    let on_working = |v: u32, proxy: Option<&Proxy>| {
-        proxy.map_or(v, |p| p.location[v as usize].nearest())
-    };
+    let on_working =
+        |v: u32, proxy: Option<&Proxy>| proxy.map_or(v, |p| p.location[v as usize].nearest());
     let params = Params {
         landmarks: job
             .params

@@ -108,7 +108,10 @@ fn a_shape_turned_at_random_gets_the_answer_placement_ignore_gives() {
             result.map.p2p_ba
         };
         use shapecorr::maps::placement::Placement;
-        assert!(map(Placement::Auto) == map(Placement::Ignore), "pose {pose}");
+        assert!(
+            map(Placement::Auto) == map(Placement::Ignore),
+            "pose {pose}"
+        );
     }
 }
 

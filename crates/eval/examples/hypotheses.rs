@@ -215,7 +215,10 @@ fn one_pair(
     }
     for &[la, lb] in &params.landmarks {
         if map.p2p_ba[lb as usize] != la {
-            eprintln!("landmark ({la}, {lb}) not kept: {}", map.p2p_ba[lb as usize]);
+            eprintln!(
+                "landmark ({la}, {lb}) not kept: {}",
+                map.p2p_ba[lb as usize]
+            );
         }
     }
     let scores = score_maps(store, pair, &maps, 1000)?;
@@ -286,9 +289,21 @@ fn random_rotation(seed: u64) -> [[f64; 3]; 3] {
     let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
     let [w, x, y, z] = q.map(|c| c / n);
     [
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
-        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
-        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - z * w),
+            2.0 * (x * z + y * w),
+        ],
+        [
+            2.0 * (x * y + z * w),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - x * w),
+        ],
+        [
+            2.0 * (x * z - y * w),
+            2.0 * (y * z + x * w),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
     ]
 }
 
@@ -309,15 +324,17 @@ fn landmarks_from_truth(vertices_b: &[[f64; 3]], truth: &[(u32, u32)], n: usize)
         return Vec::new();
     }
     let at = |p: &(u32, u32)| vertices_b[p.1 as usize];
-    let c: [f64; 3] = std::array::from_fn(|k| {
-        pairs.iter().map(|p| at(p)[k]).sum::<f64>() / pairs.len() as f64
-    });
+    let c: [f64; 3] =
+        std::array::from_fn(|k| pairs.iter().map(|p| at(p)[k]).sum::<f64>() / pairs.len() as f64);
     let d2 = |x: [f64; 3], y: [f64; 3]| (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>();
     let far = |from: &dyn Fn(usize) -> f64| {
         (0..pairs.len()).fold(0, |best, i| if from(i) > from(best) { i } else { best })
     };
     let mut chosen = vec![far(&|i| d2(at(&pairs[i]), c))];
-    let mut nearest: Vec<f64> = pairs.iter().map(|p| d2(at(p), at(&pairs[chosen[0]]))).collect();
+    let mut nearest: Vec<f64> = pairs
+        .iter()
+        .map(|p| d2(at(p), at(&pairs[chosen[0]])))
+        .collect();
     while chosen.len() < n.min(pairs.len()) {
         let next = far(&|i| nearest[i]);
         chosen.push(next);
