@@ -704,17 +704,25 @@ impl Verdict {
     /// [`crate::maps::placement::NEAR_TURN`]) no longer lower the confidence. Returns whether
     /// the frame was used.
     pub fn apply_placement(&mut self, mode: crate::maps::placement::Placement) -> bool {
-        use crate::maps::placement::{frame_pick, NEAR_TURN};
+        use crate::maps::placement::{frame_pick, FrameView, NEAR_TURN};
         let turns: Vec<f64> = self.scores.iter().map(|s| s.turn_degrees).collect();
         let costs: Vec<f64> = self.scores.iter().map(|s| s.energy.cost()).collect();
-        let eligible = |h: usize| self.scores[h].kind != HypothesisKind::Symmetric;
+        let kind = |h: usize| &self.scores[h].kind;
         let different = |h: usize, g: usize| self.distances[h][g] > DIFFERENT_MAP;
-        let Some(pick) = frame_pick(mode, &turns, &costs, &eligible, &different) else {
+        let view = FrameView {
+            turns: &turns,
+            costs: &costs,
+            eligible: &|h| *kind(h) != HypothesisKind::Symmetric,
+            from_frame: &|h| *kind(h) == HypothesisKind::Placement,
+            different: &different,
+        };
+        let Some(pick) = frame_pick(mode, &view) else {
             return false;
         };
-        for (h, out) in self.ruled_out.iter_mut().enumerate() {
-            *out = different(h, pick) && turns[h] > NEAR_TURN;
-        }
+        let ruled_out: Vec<bool> = (0..turns.len())
+            .map(|h| different(h, pick) && turns[h] > NEAR_TURN)
+            .collect();
+        self.ruled_out = ruled_out;
         self.choose(pick, Decision::Placement);
         true
     }

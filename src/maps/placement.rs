@@ -117,24 +117,46 @@ pub fn implied_rotation(
     best_rotation(&from, &to)
 }
 
-/// The hypothesis the frame picks among `turns` (degrees) and `costs`, where `eligible(h)`
-/// says which may be picked (definite hypotheses) and `different(h, g)` whether two give
-/// different maps. `Auto`: the cheapest eligible hypothesis within [`NEAR_TURN`], when it
-/// costs at most [`PLACEMENT_COST_RATIO`] times the cheapest of all and every hypothesis
-/// whose map differs from it implies at least [`FAR_TURN`] or also lies within
-/// [`NEAR_TURN`] (then the cheaper of those is the pick). `Trust`: among the eligible
-/// hypotheses within the cost ratio, the cheapest within [`NEAR_TURN`] of the least turn.
-/// `Ignore`: none.
-pub fn frame_pick(
-    mode: Placement,
-    turns: &[f64],
-    costs: &[f64],
-    eligible: &dyn Fn(usize) -> bool,
-    different: &dyn Fn(usize, usize) -> bool,
-) -> Option<usize> {
+/// The hypotheses as the frame sees them: each one's turn (degrees) and cost, which may be
+/// picked (`eligible`: definite hypotheses), which one was made from the frame itself
+/// (`from_frame`: its turn is no evidence), and whether two give different maps.
+pub struct FrameView<'a> {
+    /// The turn each hypothesis implies.
+    pub turns: &'a [f64],
+    /// Each hypothesis's cost.
+    pub costs: &'a [f64],
+    /// Whether a hypothesis may be picked.
+    pub eligible: &'a dyn Fn(usize) -> bool,
+    /// Whether a hypothesis was made from the frame ([`nearest_in_frame`]).
+    pub from_frame: &'a dyn Fn(usize) -> bool,
+    /// Whether two hypotheses give different maps.
+    pub different: &'a dyn Fn(usize, usize) -> bool,
+}
+
+/// The hypothesis the frame picks. `Auto`: among the eligible hypotheses within
+/// [`NEAR_TURN`] that cost at most [`PLACEMENT_COST_RATIO`] times the cheapest of all, the
+/// cheapest region hypothesis (the frame's own only when no region hypothesis is there: on
+/// FAUST its refined map was up to 0.026 less accurate than the region answer of the same
+/// turn, docs/placement.md), provided every other hypothesis whose map differs implies at
+/// most [`NEAR_TURN`] or at least [`FAR_TURN`]. `Trust`: among the eligible hypotheses
+/// within the cost ratio, the cheapest within [`NEAR_TURN`] of the least turn. `Ignore`:
+/// none.
+pub fn frame_pick(mode: Placement, view: &FrameView<'_>) -> Option<usize> {
+    let FrameView {
+        turns,
+        costs,
+        eligible,
+        from_frame,
+        different,
+    } = *view;
     let cheapest = costs.iter().copied().fold(f64::INFINITY, f64::min);
     let competitive = |h: usize| eligible(h) && costs[h] <= PLACEMENT_COST_RATIO * cheapest;
     let n = turns.len();
+    let cheapest_of = |among: &dyn Fn(usize) -> bool| {
+        (0..n)
+            .filter(|&h| among(h))
+            .min_by(|&x, &y| costs[x].total_cmp(&costs[y]).then(x.cmp(&y)))
+    };
     match mode {
         Placement::Ignore => None,
         Placement::Trust => {
@@ -143,16 +165,14 @@ pub fn frame_pick(
                 .filter(|&h| competitive(h))
                 .map(|h| turns[h])
                 .fold(f64::INFINITY, f64::min);
-            (0..n)
-                .filter(|&h| competitive(h) && turns[h] <= least + NEAR_TURN)
-                .min_by(|&x, &y| costs[x].total_cmp(&costs[y]).then(x.cmp(&y)))
+            cheapest_of(&|h| competitive(h) && turns[h] <= least + NEAR_TURN)
         }
         Placement::Auto => {
-            let pick = (0..n)
-                .filter(|&h| competitive(h) && turns[h] <= NEAR_TURN)
-                .min_by(|&x, &y| costs[x].total_cmp(&costs[y]).then(x.cmp(&y)))?;
-            let undecided =
-                (0..n).any(|h| different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN);
+            let near = |h: usize| competitive(h) && turns[h] <= NEAR_TURN;
+            let pick = cheapest_of(&|h| near(h) && !from_frame(h)).or_else(|| cheapest_of(&near))?;
+            let undecided = (0..n).any(|h| {
+                !from_frame(h) && different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN
+            });
             (!undecided).then_some(pick)
         }
     }
@@ -226,59 +246,71 @@ mod tests {
     }
 
     #[test]
+    fn auto_takes_a_region_answer_before_the_frames_own_map() {
+        let (yes, differ) = (|_: usize| true, |h: usize, g: usize| h != g);
+        let own = |h: usize| h == 2;
+        let view = |turns: &'static [f64]| FrameView {
+            turns,
+            costs: &[1.0, 1.2, 0.9],
+            eligible: &yes,
+            from_frame: &own,
+            different: &differ,
+        };
+        // The frame's own map is cheaper, but a region answer stands near it.
+        assert_eq!(frame_pick(Placement::Auto, &view(&[170.0, 10.0, 5.0])), Some(1));
+        // No region answer near no turn: the frame's own map.
+        assert_eq!(frame_pick(Placement::Auto, &view(&[170.0, 175.0, 5.0])), Some(2));
+    }
+
+    #[test]
     fn auto_uses_the_frame_only_when_it_separates_the_answers() {
         let yes = |_: usize| true;
+        let no = |_: usize| false;
         let differ = |h: usize, g: usize| h != g;
+        let pick = |mode, turns: &[f64], costs: &[f64]| {
+            frame_pick(
+                mode,
+                &FrameView {
+                    turns,
+                    costs,
+                    eligible: &yes,
+                    from_frame: &no,
+                    different: &differ,
+                },
+            )
+        };
         let costs = [1.0, 1.1, 1.2];
         // The cheapest answer is half-turned, a near-identity rival within the cost ratio.
         assert_eq!(
-            frame_pick(Placement::Auto, &[178.0, 5.0, 160.0], &costs, &yes, &differ),
+            pick(Placement::Auto, &[178.0, 5.0, 160.0], &costs),
             Some(1)
         );
         // An answer between the two thresholds: undecided.
         assert_eq!(
-            frame_pick(Placement::Auto, &[60.0, 5.0, 160.0], &costs, &yes, &differ),
+            pick(Placement::Auto, &[60.0, 5.0, 160.0], &costs),
             None
         );
         // No answer near no turn (shapes turned at random): nothing.
         assert_eq!(
-            frame_pick(
-                Placement::Auto,
-                &[120.0, 140.0, 160.0],
-                &costs,
-                &yes,
-                &differ
-            ),
+            pick(Placement::Auto, &[120.0, 140.0, 160.0], &costs),
             None
         );
         // Too costly to be picked.
         assert_eq!(
-            frame_pick(Placement::Auto, &[178.0, 5.0], &[1.0, 3.5], &yes, &differ),
+            pick(Placement::Auto, &[178.0, 5.0], &[1.0, 3.5]),
             None
         );
         assert_eq!(
-            frame_pick(
-                Placement::Trust,
-                &[120.0, 60.0, 160.0],
-                &costs,
-                &yes,
-                &differ
-            ),
+            pick(Placement::Trust, &[120.0, 60.0, 160.0], &costs),
             Some(1)
         );
         // Trust: two answers of about the same least turn, the cheaper one.
         assert_eq!(
-            frame_pick(Placement::Trust, &[9.0, 8.0, 160.0], &costs, &yes, &differ),
+            pick(Placement::Trust, &[9.0, 8.0, 160.0], &costs),
             Some(0)
         );
         assert_eq!(
-            frame_pick(
-                Placement::Ignore,
-                &[178.0, 5.0, 160.0],
-                &costs,
-                &yes,
-                &differ
-            ),
+            pick(Placement::Ignore, &[178.0, 5.0, 160.0], &costs),
             None
         );
     }

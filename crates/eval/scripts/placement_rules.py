@@ -73,16 +73,20 @@ def random_rotation(rng):
 
 
 def frame_pick(hs, turns, rule, with_placement=True):
+    """The library's rule (src/maps/placement.rs, `frame_pick`, `Auto`): a region
+    hypothesis before the frame's own map; the frame's own map never leaves it undecided."""
     near, far, ratio = rule
     idx = [i for i, h in enumerate(hs) if with_placement or h["hypothesis"] != "placement"]
+    own = lambda i: hs[i]["hypothesis"] == "placement"
     cheapest = min(hs[i]["cost"] for i in idx)
     ok = lambda i: hs[i]["hypothesis"] != "symmetric" and hs[i]["cost"] <= ratio * cheapest
     cands = [i for i in idx if ok(i) and turns[i] <= near]
     if not cands:
         return None
-    pick = min(cands, key=lambda i: (hs[i]["cost"], i))
+    region = [i for i in cands if not own(i)]
+    pick = min(region or cands, key=lambda i: (hs[i]["cost"], i))
     for i in idx:
-        if hs[i]["dist"][pick] > DIFFERENT_MAP and near < turns[i] < far:
+        if not own(i) and hs[i]["dist"][pick] > DIFFERENT_MAP and near < turns[i] < far:
             return None
     return pick
 
