@@ -531,6 +531,7 @@ pub unsafe extern "C" fn sc_correspondence_other_answer(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ffi::{SC_ANSWER_CHOSEN, SC_ANSWER_RUNNER_UP};
     use crate::maps::hypotheses::{
         HypothesisKind, HypothesisScore, MapEnergy, Verdict, DOUBTFUL_BELOW,
     };
@@ -572,6 +573,11 @@ mod tests {
 
     /// A handle as the C API gives one out (an `Arc`'s pointer; see `ffi::boundary`).
     fn with_verdict(confidence: Option<f64>) -> *const ScCorrespondence {
+        with_mirror_at(confidence, 0.3)
+    }
+
+    /// As [`with_verdict`], the mirror's map `distance` from the answer's.
+    fn with_mirror_at(confidence: Option<f64>, distance: f64) -> *const ScCorrespondence {
         let correspondence = ScCorrespondence::new(Correspondence {
             k: 5,
             graph_a: empty_graph(),
@@ -584,11 +590,11 @@ mod tests {
                 chosen: 0,
                 scores: vec![
                     score(HypothesisKind::Answer, 0.05, 0.0),
-                    score(HypothesisKind::Mirror, 0.051, 0.3),
+                    score(HypothesisKind::Mirror, 0.051, distance),
                 ],
                 confidence,
                 decided_by: crate::maps::hypotheses::Decision::Cost,
-                distances: vec![vec![0.0, 0.3], vec![0.3, 0.0]],
+                distances: vec![vec![0.0, distance], vec![distance, 0.0]],
                 ruled_out: vec![false; 2],
             }),
             estimate: None,
@@ -622,6 +628,67 @@ mod tests {
             );
             for handle in [none, sure, doubtful] {
                 sc_correspondence_free(handle.cast_mut());
+            }
+        }
+    }
+
+    unsafe fn name(c: *const ScCorrespondence, which: u32) -> Option<String> {
+        let p = sc_correspondence_hypothesis(c, which);
+        (!p.is_null()).then(|| CStr::from_ptr(p).to_str().unwrap().to_string())
+    }
+
+    #[test]
+    fn the_other_answer_is_the_runner_up_with_its_verdict() {
+        let c = with_verdict(Some(0.9));
+        unsafe {
+            assert_eq!(name(c, SC_ANSWER_CHOSEN).as_deref(), Some("answer"));
+            assert_eq!(name(c, SC_ANSWER_RUNNER_UP).as_deref(), Some("mirror"));
+            assert_eq!(
+                sc_correspondence_hypothesis_cost(c, SC_ANSWER_RUNNER_UP),
+                0.051
+            );
+            assert_eq!(CStr::from_ptr(sc_correspondence_decided_by(c)), c"cost");
+            assert!(!sc_correspondence_placement_used(c));
+            let mut other = std::ptr::null_mut();
+            assert_eq!(sc_correspondence_other_answer(c, &mut other), ScStatus::Ok);
+            assert_eq!(name(other, SC_ANSWER_CHOSEN).as_deref(), Some("mirror"));
+            assert_eq!(name(other, SC_ANSWER_RUNNER_UP).as_deref(), Some("answer"));
+            assert_eq!(
+                sc_correspondence_hypothesis_cost(other, SC_ANSWER_CHOSEN),
+                0.051
+            );
+            assert_eq!(
+                CStr::from_ptr(sc_correspondence_decided_by(other)),
+                c"other answer"
+            );
+            sc_correspondence_free(other);
+            sc_correspondence_free(c.cast_mut());
+        }
+    }
+
+    #[test]
+    fn without_a_different_map_or_a_verdict_there_is_no_other_answer() {
+        let same = with_mirror_at(Some(0.9), 0.0);
+        let unverified = with_verdict(None);
+        unsafe {
+            assert_eq!(name(same, SC_ANSWER_CHOSEN).as_deref(), Some("answer"));
+            assert_eq!(name(same, SC_ANSWER_RUNNER_UP), None);
+            assert!(sc_correspondence_turn_degrees(same, SC_ANSWER_RUNNER_UP).is_nan());
+            assert_eq!(name(unverified, SC_ANSWER_CHOSEN), None);
+            assert!(sc_correspondence_decided_by(unverified).is_null());
+            for (c, why) in [(same, "different map"), (unverified, "not verified")] {
+                let sentinel = 0x10 as *mut ScCorrespondence;
+                let mut out = sentinel;
+                assert_eq!(
+                    sc_correspondence_other_answer(c, &mut out),
+                    ScStatus::InvalidArgument
+                );
+                assert_eq!(out, sentinel, "nothing written on failure");
+                let message = CStr::from_ptr(super::super::sc_last_error())
+                    .to_str()
+                    .unwrap();
+                assert!(message.starts_with("no other answer") && message.contains(why));
+                sc_correspondence_free(c.cast_mut());
             }
         }
     }
