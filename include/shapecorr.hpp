@@ -9,6 +9,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "shapecorr.h"
@@ -82,6 +83,17 @@ class Params {
     Params &set(const char *name, int v) { return set(name, static_cast<std::int64_t>(v)); }
     Params &set(const char *name, double v) { check(sc_params_set_double(ptr_.get(), name, v)); return *this; }
     Params &set(const char *name, bool v) { check(sc_params_set_bool(ptr_.get(), name, v)); return *this; }
+    // Landmark pairs (vertex of A, vertex of B), replacing those set before; checked against
+    // the shapes when a job starts.
+    Params &set_landmarks(const std::vector<std::pair<std::uint32_t, std::uint32_t>> &pairs) {
+        std::vector<std::uint32_t> flat;
+        for (const auto &p : pairs) {
+            flat.push_back(p.first);
+            flat.push_back(p.second);
+        }
+        check(sc_params_set_landmarks(ptr_.get(), flat.data(), pairs.size()));
+        return *this;
+    }
     const sc_params *get() const noexcept { return ptr_.get(); }
 
   private:
@@ -128,9 +140,42 @@ class Correspondence {
             return std::nullopt;
         return std::string(text);
     }
+    // The name of hypothesis `which` (SC_ANSWER_CHOSEN or SC_ANSWER_RUNNER_UP); nothing when
+    // the answer was not verified or there is no runner-up.
+    std::optional<std::string> hypothesis(std::uint32_t which) const {
+        const char *name = sc_correspondence_hypothesis(ptr_.get(), which);
+        if (name == nullptr)
+            return std::nullopt;
+        return std::string(name);
+    }
+    // Its cost and the turn (degrees) its map implies; NaN when there is none.
+    double hypothesis_cost(std::uint32_t which) const {
+        return sc_correspondence_hypothesis_cost(ptr_.get(), which);
+    }
+    double turn_degrees(std::uint32_t which) const {
+        return sc_correspondence_turn_degrees(ptr_.get(), which);
+    }
+    // What settled the choice ("cost", "close call", "placement", "landmarks", "other
+    // answer"); nothing when the answer was not verified.
+    std::optional<std::string> decided_by() const {
+        const char *name = sc_correspondence_decided_by(ptr_.get());
+        if (name == nullptr)
+            return std::nullopt;
+        return std::string(name);
+    }
+    bool placement_used() const { return sc_correspondence_placement_used(ptr_.get()); }
+    // The runner-up's answer (nothing recomputed); nothing when there is no runner-up.
+    std::optional<Correspondence> other_answer() const {
+        if (sc_correspondence_hypothesis(ptr_.get(), SC_ANSWER_RUNNER_UP) == nullptr)
+            return std::nullopt;
+        sc_correspondence *p = nullptr;
+        check(sc_correspondence_other_answer(ptr_.get(), &p));
+        return Correspondence(p);
+    }
     const sc_correspondence *get() const noexcept { return ptr_.get(); }
 
   private:
+    explicit Correspondence(sc_correspondence *p) : ptr_(p) {}
     std::unique_ptr<sc_correspondence, detail::CorrespondenceFree> ptr_;
 };
 

@@ -42,9 +42,40 @@ int main() {
                         warning ? warning->c_str() : "(none)");
             failures++;
         }
+        // The verdict: a hypothesis exactly when verified; the other answer is the runner-up.
+        auto chosen = c.hypothesis(SC_ANSWER_CHOSEN), runner_up = c.hypothesis(SC_ANSWER_RUNNER_UP);
+        auto other = c.other_answer();
+        std::printf("C++ wrapper: hypothesis %s decided by %s, runner-up %s\n",
+                    chosen ? chosen->c_str() : "(none)",
+                    c.decided_by() ? c.decided_by()->c_str() : "(none)",
+                    runner_up ? runner_up->c_str() : "(none)");
+        if (chosen.has_value() == std::isnan(c.confidence()) ||
+            c.decided_by().has_value() != chosen.has_value() ||
+            other.has_value() != runner_up.has_value() ||
+            (other && (other->hypothesis(SC_ANSWER_CHOSEN) != runner_up ||
+                       other->decided_by() != std::optional<std::string>("other answer") ||
+                       other->turn_degrees(SC_ANSWER_CHOSEN) != c.turn_degrees(SC_ANSWER_RUNNER_UP)))) {
+            std::printf("FAIL: inconsistent verdict or other answer\n");
+            failures++;
+        }
     } catch (const shapecorr::Error &e) {
         std::printf("FAIL: %s\n", e.what());
         failures++;
+    }
+    try {
+        // A landmark past the end of B fails the job before any work, naming the pair.
+        shapecorr::Shape a = shapecorr::Shape::figure("star4", 0, 1500);
+        shapecorr::Shape b = shapecorr::Shape::figure("star4", 2, 1500);
+        shapecorr::Params params;
+        params.set_landmarks({{3, 3}, {5, 99999}});
+        shapecorr::Correspondence c(a, b, &params);
+        std::printf("FAIL: no exception for a landmark out of range\n");
+        failures++;
+    } catch (const shapecorr::Error &e) {
+        if (e.status() != SC_STATUS_INVALID_PARAMETER || std::strstr(e.what(), "pair 2") == nullptr) {
+            std::printf("FAIL: wrong error %u: %s\n", unsigned(e.status()), e.what());
+            failures++;
+        }
     }
     try {
         shapecorr::Params params;
