@@ -8,6 +8,7 @@
 
 mod commands;
 mod input;
+mod landmarks;
 mod options;
 mod output;
 
