@@ -74,8 +74,10 @@ pub struct ShapePairArgs {
     pub no_repair: bool,
     /// Landmark pairs: a text file with a vertex of A, then the vertex of B that corresponds
     /// to it, on each line (0-based indices of the files' vertices, separated by spaces, tabs
-    /// or one comma; `#` starts a comment). Each landmark of B maps to its partner; two pairs
-    /// on one side of a body settle which side is which. See docs/placement.md.
+    /// or one comma; `#` starts a comment). The answer is the one that carries them nearest
+    /// their partners, and in a map (`p2p`, `transfer`) each landmark of B maps exactly to
+    /// its partner; two pairs on one side of a body settle which side is which. See
+    /// docs/placement.md.
     #[arg(long, value_name = "FILE")]
     pub landmarks: Option<PathBuf>,
 }

@@ -201,6 +201,15 @@ fn placement_is_an_option_with_three_values() {
         let result = result_json(&out);
         check_choice(&result, &String::from_utf8_lossy(&done.stdout), mode);
         assert_eq!(result["placement"]["used"], used, "{mode}");
+        // The runner-up's one-to-one regions, written beside the answer.
+        if !result["runner_up"].is_null() {
+            let other = result_json(&out.join("other"));
+            assert_eq!(other["chosen"]["kind"], result["runner_up"]["kind"]);
+            assert_eq!(other["chosen"]["decided_by"], "other answer");
+            assert_ne!(other["matches_one_to_one"], result["matches_one_to_one"]);
+            assert_eq!(other["regions_b"], result["regions_b"]);
+            assert!(out.join("other/b_regions.ply").is_file());
+        }
         let expected = ["auto", "ignore", "trust"].iter().position(|m| *m == mode);
         assert_eq!(
             result["options"]["placement"].as_u64(),
