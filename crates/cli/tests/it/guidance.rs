@@ -117,6 +117,10 @@ fn a_malformed_or_wrong_landmarks_file_fails_naming_it_and_writes_nothing() {
             "10 12\n10 13\n".into(),
             vec!["landmarks.txt", "contradict each other"],
         ),
+        (
+            (0..101).map(|v| format!("{v} {v}\n")).collect(),
+            vec!["landmarks.txt", "101 pairs given, at most 100"],
+        ),
     ] {
         std::fs::write(&file, &text).unwrap();
         for command in ["p2p", "match"] {
