@@ -337,7 +337,7 @@ def _landmarks_argument(parser):
     parser.add_argument(
         "--landmarks", metavar="FILE",
         help="landmark pairs: a vertex of A, then its partner on B, a line each (0-based; spaces, tabs or "
-        "one comma; # comments); each landmark of B maps to its partner (docs/placement.md)",
+        "one comma; # comments); the answer carrying them nearest their partners is chosen (docs/placement.md)",
     )
 
 
