@@ -22,8 +22,13 @@ and when the answer is doubtful a warning on stderr (``shapecorr_meshlab: warnin
 The command's options are generated from the library's option table
 (``shapecorr.options()``, the same as the ``shapecorr`` command line's): one per region
 option, named as the option with ``-`` for ``_`` (``--k-min 5``, ``--gap-ratio 0.85``,
-``--one-to-one false``), plus ``--set NAME=VALUE`` (repeatable, the table's spelling,
-applied after them).
+``--one-to-one false``, ``--placement trust``), plus ``--set NAME=VALUE`` (repeatable, the
+table's spelling, applied after them). ``--landmarks FILE`` gives landmark pairs (a vertex
+of A, then its partner on B, a line each; the format of ``shapecorr --landmarks``,
+docs/placement.md).
+
+The report names the hypothesis chosen, what decided it (the cost, the shapes' placement,
+the landmarks), the turn it implies between B and A, and the runner-up's cost.
 
 Transfer (docs/transfer.md) carries A's vertex colours, quality and per-vertex texture coordinates
 to B through the correspondence, whatever their poses and bodies::
@@ -80,22 +85,110 @@ def coloured(mesh, regions, rgba):
 def match_regions(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, progress=None, **options):
     """Matches meshes ``id_a`` and ``id_b`` of the MeshSet ``ms`` and returns a new MeshSet
     holding their coloured copies (A first, then B). ``options`` are shapecorr's named
-    options (``k_min``, ``k_max``, ...; ``shapecorr.options()`` lists them). Raises
-    shapecorr.ShapecorrError on bad input."""
+    options (``k_min``, ``k_max``, ``placement``, ...; ``shapecorr.options()`` lists them)
+    and ``landmarks=[(vertex of A, vertex of B), ...]``. Raises shapecorr.ShapecorrError on
+    bad input (a landmark out of range too)."""
     return match(ms, id_a, id_b, one_to_one, as_point_cloud, progress, **options)[0]
+
+
+def _field(record, name):
+    """``record.name``, or ``record[name]`` for a runner-up given as a dict."""
+    return record[name] if isinstance(record, dict) else getattr(record, name)
+
+
+def choice_text(result):
+    """How the answer was chosen, for the report: ``hypothesis 'answer' decided by placement
+    (placement used), turn 9 degrees, runner-up 'mirror' cost 0.0757`` (``no runner-up``
+    when every other hypothesis gives the same map); empty when it was not verified."""
+    if result.hypothesis is None:
+        return ""
+    used = "used" if result.placement_used else "not used"
+    text = f"hypothesis '{result.hypothesis}' decided by {result.decided_by} (placement {used})"
+    if result.turn_degrees is not None:
+        text += f", turn {result.turn_degrees:.0f} degrees"
+    runner_up = result.runner_up
+    if runner_up is None:
+        return text + ", no runner-up"
+    return text + f", runner-up '{_field(runner_up, 'hypothesis')}' cost {_field(runner_up, 'cost'):.4g}"
+
+
+#: What to do about a doubtful answer (docs/placement.md).
+ADVICE = (
+    "to check or correct it: give two landmark pairs with --landmarks FILE (say a left hand and a left "
+    "foot, a vertex of A then its partner on B), or use --placement trust when the shapes stand alike"
+)
 
 
 def report(result, shapes=()):
     """The lines of the report on a match: the confidence of the answer (``confidence
-    0.74``, or ``not verified`` when it has none), ``warning: ...`` when it is doubtful,
-    and ``repaired A: ...`` for every repair the library made to ``shapes`` (A, then B)."""
+    0.74``, or ``not verified`` when it has none) and how it was chosen (:func:`choice_text`),
+    ``warning: ...`` and what to do (:data:`ADVICE`) when it is doubtful, and ``repaired A:
+    ...`` for every repair the library made to ``shapes`` (A, then B)."""
     confidence = result.confidence
-    lines = ["not verified" if confidence is None else f"confidence {confidence:.2f}"]
+    first = "not verified" if confidence is None else f"confidence {confidence:.2f}"
+    choice = choice_text(result)
+    lines = [f"{first}, {choice}" if choice else first]
     if result.warning is not None:
         lines.append(f"warning: {result.warning}")
+        lines.append(ADVICE)
     for side, shape in zip("AB", shapes):
         lines.extend(f"repaired {side}: {repair}" for repair in shape.repairs)
     return lines
+
+
+def read_landmarks(path):
+    """The landmark pairs of a text file, ``[(vertex of A, vertex of B), ...]``: two 0-based
+    vertex indices a line, separated by spaces, tabs or one comma; ``#`` starts a comment,
+    blank lines are skipped (the format ``shapecorr --landmarks`` reads). Raises ValueError
+    naming the file, the line and the column of a malformed line; the library checks the
+    pairs against the shapes (out of range, left out by its repairs, contradicting)."""
+    limit = 1 << 20
+    with open(path, "rb") as file:
+        data = file.read(limit + 1)
+    if len(data) > limit:
+        raise ValueError(f"{path}: more than {limit} bytes: not a landmarks file")
+    text = data.removeprefix(b"\xef\xbb\xbf").decode("ascii", errors="replace")
+    pairs = []
+    for number, line in enumerate(text.split("\n"), start=1):
+        line = line.removesuffix("\r").split("#", 1)[0]
+        try:
+            pair = _landmark_line(line)
+        except _LineError as error:
+            column, reason = error.args
+            raise ValueError(f"{path}: line {number}, column {column}: {reason}") from None
+        if pair is not None:
+            pairs.append(pair)
+    return pairs
+
+
+class _LineError(Exception):
+    """A malformed line of a landmarks file: ``(column, reason)``."""
+
+
+def _landmark_line(line):
+    """The pair on one line (comment removed), None for a blank one; raises _LineError."""
+    fields = [(m.group(), m.start() + 1) for m in re.finditer(r"[^ \t,]+", line)]
+    commas = [k + 1 for k, c in enumerate(line) if c == ","]
+    if not fields:
+        if commas:
+            raise _LineError(commas[0], "a comma with no vertex index")
+        return None
+    if len(commas) > 1:
+        raise _LineError(commas[1], "a second comma: a line is two vertex indices separated by spaces, tabs or one comma")
+    if len(fields) > 2:
+        raise _LineError(fields[2][1], f"a third value `{fields[2][0]}`: a line is two vertex indices, A's then B's")
+    if len(fields) < 2:
+        raise _LineError(len(line.rstrip(" \t,")) + 1, "B's vertex is missing: a line is two vertex indices, A's then B's")
+    if commas and not fields[0][1] < commas[0] < fields[1][1]:
+        raise _LineError(commas[0], "a comma that is not between the two vertex indices")
+    for (value, column), side in zip(fields, "AB"):
+        if re.fullmatch(r"-[0-9]+", value):
+            raise _LineError(column, f"{side}'s vertex `{value}` is negative: vertex indices start at 0")
+        if not re.fullmatch(r"[0-9]+", value):
+            raise _LineError(column, f"{side}'s vertex `{value}` is not a vertex index (a whole number from 0)")
+        if int(value) >= 2**32:
+            raise _LineError(column, f"{side}'s vertex `{value}` is larger than any vertex index")
+    return int(fields[0][0]), int(fields[1][0])
 
 
 def match(ms, id_a=0, id_b=1, one_to_one=True, as_point_cloud=False, progress=None, **options):
@@ -163,9 +256,12 @@ def region_options():
     return [option for option in shapecorr.options() if not option[0].startswith("p2p_")]
 
 
-def parse_value(name, kind, text):
-    """A value of option ``name`` of type ``kind`` ("int", "float" or "bool") from text."""
+def parse_value(name, kind, text, choices=()):
+    """A value of option ``name`` of type ``kind`` ("int", "float" or "bool") from text; a
+    choice (``placement``) also by one of its names ``choices``, kept as the name."""
     word = text.strip().lower()
+    if word in choices:
+        return word
     try:
         if kind == "bool":
             if word in _TRUE or word in _FALSE:
@@ -174,15 +270,18 @@ def parse_value(name, kind, text):
         return int(word) if kind == "int" else float(word)
     except ValueError:
         expected = {"int": "an integer", "float": "a number", "bool": "true or false (yes/no, 1/0)"}[kind]
+        if choices:
+            expected = "one of " + ", ".join(f"{choice} ({i})" for i, choice in enumerate(choices))
         raise argparse.ArgumentTypeError(f"option `{name}` expects {expected}, got {text!r}") from None
 
 
-def _option_parser(name, kind):
-    return lambda text: parse_value(name, kind, text)
+def _option_parser(name, kind, choices):
+    return lambda text: parse_value(name, kind, text, choices)
 
 
 def _set_parser(table):
-    kinds = {name: kind for name, kind, _doc, _default in table}
+    kinds = {option.name: option.kind for option in table}
+    choices = {option.name: option.choices for option in table}
 
     def parse(text):
         name, equals, value = text.partition("=")
@@ -191,7 +290,7 @@ def _set_parser(table):
             raise argparse.ArgumentTypeError(f"expected NAME=VALUE (e.g. k_max=8), got {text!r}")
         if name not in kinds:
             raise argparse.ArgumentTypeError(f"unknown option `{name}`; the options are: {', '.join(kinds)}")
-        return name, parse_value(name, kinds[name], value)
+        return name, parse_value(name, kinds[name], value, choices[name])
 
     return parse
 
@@ -207,14 +306,17 @@ def argument_parser():
     parser.add_argument("--points", action="store_true", help="treat both as point clouds")
     table = region_options()
     group = parser.add_argument_group("region options (the library's option table)")
-    for name, kind, doc, default in table:
+    for option in table:
+        name, kind, doc, default = option
         metavar = {"int": "INT", "float": "NUMBER", "bool": "true|false"}[kind]
         shown = str(default).lower() if kind == "bool" else default
+        if option.choices:
+            metavar, shown = "|".join(option.choices), option.choices[default]
         group.add_argument(
             "--" + name.replace("_", "-"),
             dest=f"option:{name}",
             metavar=metavar,
-            type=_option_parser(name, kind),
+            type=_option_parser(name, kind, option.choices),
             default=argparse.SUPPRESS,
             help=f"{doc} (default: {shown})".replace("%", "%%"),
         )
@@ -227,7 +329,21 @@ def argument_parser():
         type=_set_parser(table),
         help="set any of the options above by its table name (k_max=8), after them; repeatable",
     )
+    _landmarks_argument(parser)
     return parser
+
+
+def _landmarks_argument(parser):
+    parser.add_argument(
+        "--landmarks", metavar="FILE",
+        help="landmark pairs: a vertex of A, then its partner on B, a line each (0-based; spaces, tabs or "
+        "one comma; # comments); the answer carrying them nearest their partners is chosen (docs/placement.md)",
+    )
+
+
+def landmarks_of(args):
+    """``{"landmarks": pairs}`` from ``--landmarks FILE`` (:func:`read_landmarks`), or ``{}``."""
+    return {} if args.landmarks is None else {"landmarks": read_landmarks(args.landmarks)}
 
 
 def options_of(args):
@@ -252,6 +368,7 @@ def transfer_parser():
         "--set", dest="set", metavar="NAME=VALUE", action="append", default=[],
         type=_set_parser(shapecorr.options()), help="a library option by its table name (k_max=8); repeatable",
     )
+    _landmarks_argument(parser)
     return parser
 
 
@@ -295,13 +412,18 @@ def print_report(wrote, lines):
 
 def main_transfer(argv):
     args = transfer_parser().parse_args(argv)
+    try:
+        landmarks = landmarks_of(args)
+    except (OSError, ValueError) as error:
+        print(f"shapecorr_meshlab: {error}", file=sys.stderr)
+        return 1
     ms = load_pair(args.a, args.b)
     if ms is None:
         return 1
     try:
         out, pointwise = transfer(
             ms, colors=not args.no_colors, quality=not args.no_quality, texcoords=not args.no_texcoords,
-            **dict(args.set),
+            **dict(args.set), **landmarks,
         )
     except (shapecorr.ShapecorrError, ValueError) as error:
         print(f"shapecorr_meshlab: {error}", file=sys.stderr)
@@ -323,6 +445,11 @@ def main(argv=None):
     args = argument_parser().parse_args(argv)
     options = options_of(args)
     one_to_one = options.pop("one_to_one", True) and not args.symmetric
+    try:
+        options.update(landmarks_of(args))
+    except (OSError, ValueError) as error:
+        print(f"shapecorr_meshlab: {error}", file=sys.stderr)
+        return 1
     ms = load_pair(args.a, args.b)
     if ms is None:
         return 1

@@ -53,8 +53,9 @@ def test_function_takes_and_returns_a_meshset():
     assert result.confidence is not None and 0.0 <= result.confidence <= 1.0
     assert result.confidence == expected.confidence
     lines = shapecorr_meshlab.report(result)
-    assert lines[0] == f"confidence {expected.confidence:.2f}"
-    assert lines[1:] == ([f"warning: {expected.warning}"] if expected.doubtful else [])
+    assert lines[0].startswith(f"confidence {expected.confidence:.2f}, hypothesis '{result.hypothesis}'")
+    advice = [f"warning: {expected.warning}", shapecorr_meshlab.ADVICE]
+    assert lines[1:] == (advice if expected.doubtful else [])
 
 
 def run_script(*args):
@@ -82,7 +83,7 @@ def test_command_writes_coloured_files_with_region_ids(tmp_path):
     assert agree > 0.5, agree
     # The report gives the confidence; a warning on stderr only when doubtful.
     assert expected.confidence is not None
-    assert f"(confidence {expected.confidence:.2f})" in done.stdout, done.stdout
+    assert f"(confidence {expected.confidence:.2f}, hypothesis '" in done.stdout, done.stdout
     assert ("shapecorr_meshlab: warning:" in done.stderr) == expected.doubtful, done.stderr
 
 
@@ -96,8 +97,9 @@ def test_a_doubtful_answer_is_reported_with_its_warning(tmp_path):
     assert done.returncode == 0, done.stderr
     expected = shapecorr.match(shapecorr.Shape.read(tmp_path / "a.ply"), shapecorr.Shape.read(tmp_path / "b.ply"))
     assert expected.doubtful, expected.confidence
-    assert f"(confidence {expected.confidence:.2f})" in done.stdout, done.stdout
+    assert f"(confidence {expected.confidence:.2f}, hypothesis '" in done.stdout, done.stdout
     assert f"shapecorr_meshlab: warning: {expected.warning}" in done.stderr.splitlines(), done.stderr
+    assert f"shapecorr_meshlab: {shapecorr_meshlab.ADVICE}" in done.stderr.splitlines(), done.stderr
     assert (tmp_path / "a_col.ply").exists() and (tmp_path / "b_col.ply").exists()
 
 
@@ -175,6 +177,116 @@ def test_the_repairs_made_are_reported(tmp_path):
     )
     assert run.returncode == 0, run.stderr
     assert "shapecorr_meshlab: repaired B: 1 vertices far from" in run.stderr, run.stderr
+
+
+# ------------------------------------------------------------------------ placement, landmarks
+
+
+def test_placement_is_taken_by_name_and_a_wrong_one_refused(tmp_path):
+    parser = shapecorr_meshlab.argument_parser()
+    base = ["a.ply", "b.ply", "--out-a", "x.ply", "--out-b", "y.ply"]
+    for args, expected in ((["--placement", "trust"], "trust"), (["--set", "placement=Ignore"], "ignore"),
+                           (["--placement", "2"], 2)):
+        assert shapecorr_meshlab.options_of(parser.parse_args(base + args)) == {"placement": expected}
+    save(figure_mesh("humanoid", 0, 2000), tmp_path / "a.ply")
+    save(figure_mesh("humanoid", 3, 2000), tmp_path / "b.ply")
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply",
+                      "--placement", "bogus")
+    assert done.returncode == 2 and "auto (0), ignore (1), trust (2)" in done.stderr, done.stderr
+    # The name reaches the library: `ignore` never lets the shapes' placement decide.
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(tmp_path / "a.ply"))
+    ms.load_new_mesh(str(tmp_path / "b.ply"))
+    _, result = shapecorr_meshlab.match(ms, placement="ignore")
+    assert result.hypothesis is not None and not result.placement_used and result.decided_by != "placement"
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        ("1 2\n3\n", "line 2, column 2: B's vertex is missing"),
+        ("1 2 3\n", "line 1, column 5: a third value `3`"),
+        ("1,2,3\n", "line 1, column 4: a second comma"),
+        (",1 2\n", "line 1, column 1: a comma that is not between"),
+        ("\n\n  4 x9\n", "line 3, column 5: B's vertex `x9` is not a vertex index"),
+        ("-1 2\n", "line 1, column 1: A's vertex `-1` is negative"),
+        ("1 4294967296\n", "line 1, column 3: B's vertex `4294967296` is larger"),
+    ],
+)
+def test_a_malformed_landmarks_file_names_line_and_column(tmp_path, text, expected):
+    path = tmp_path / "landmarks.txt"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=expected.replace("(", r"\(")) as error:
+        shapecorr_meshlab.read_landmarks(path)
+    assert str(path) in str(error.value)
+
+
+def test_landmarks_files_are_read_like_the_command_line_and_bad_ones_write_nothing(tmp_path):
+    path = tmp_path / "landmarks.txt"
+    path.write_bytes(b"\xef\xbb\xbf# A B\n12 40\n\n  7\t9  # left hand\r\n3,4\n5 , 6\n")
+    assert shapecorr_meshlab.read_landmarks(path) == [(12, 40), (7, 9), (3, 4), (5, 6)]
+    save(figure_mesh("humanoid", 0, 2000), tmp_path / "a.ply")
+    save(figure_mesh("humanoid", 3, 2000), tmp_path / "b.ply")
+    path.write_text("10 10\n7 x\n")
+    outputs = ("--out-a", tmp_path / "x.ply", "--out-b", tmp_path / "y.ply")
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", *outputs, "--landmarks", path)
+    assert done.returncode == 1 and "line 2, column 3" in done.stderr and "Traceback" not in done.stderr, done.stderr
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", *outputs, "--landmarks", tmp_path / "none.txt")
+    assert done.returncode == 1 and "none.txt" in done.stderr and "Traceback" not in done.stderr, done.stderr
+    # Checked by the library against the shapes: B has fewer vertices than this.
+    path.write_text("10 10\n20 99999\n")
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", *outputs, "--landmarks", path)
+    assert done.returncode == 1 and "vertex 99999 is not a vertex of B" in done.stderr, done.stderr
+    assert not (tmp_path / "x.ply").exists() and not (tmp_path / "y.ply").exists()
+    done = run_script("transfer", tmp_path / "a.ply", tmp_path / "b.ply", "--out", tmp_path / "x.ply", "--landmarks", path)
+    assert done.returncode == 1 and not (tmp_path / "x.ply").exists(), done.stderr
+
+
+def test_landmarks_reach_the_library_and_the_report_names_the_choice(tmp_path):
+    """Two figures sharing their vertex order, two true landmark pairs: the command passes
+    them on (the library's answer with them is the script's), and the report names the
+    hypothesis, what decided it and the runner-up's cost."""
+    save(figure_mesh("humanoid", 0, 2000), tmp_path / "a.ply")
+    save(figure_mesh("humanoid", 3, 2000), tmp_path / "b.ply")
+    path = tmp_path / "landmarks.txt"
+    path.write_text("# hand, foot\n10 10\n1500, 1500\n")
+    done = run_script(tmp_path / "a.ply", tmp_path / "b.ply", "--out-a", tmp_path / "a_col.ply",
+                      "--out-b", tmp_path / "b_col.ply", "--landmarks", path)
+    assert done.returncode == 0, done.stderr
+    shapes = (shapecorr.Shape.read(tmp_path / "a.ply"), shapecorr.Shape.read(tmp_path / "b.ply"))
+    expected = shapecorr.match(*shapes, landmarks=[(10, 10), (1500, 1500)])
+    assert expected.hypothesis is not None
+    first = shapecorr_meshlab.report(expected)[0]
+    assert f"({first})" in done.stdout, done.stdout
+    assert f"hypothesis '{expected.hypothesis}' decided by {expected.decided_by}" in first
+    if expected.runner_up is not None:
+        assert "runner-up '" in first and " cost " in first, first
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(tmp_path / "b_col.ply"))
+    colours = np.round(ms.current_mesh().vertex_color_matrix() * 255).astype(np.uint8)
+    assert np.array_equal(colours, expected.colors("b"))
+
+
+def test_the_report_says_how_the_answer_was_chosen_and_what_to_do():
+    from types import SimpleNamespace
+
+    result = SimpleNamespace(
+        confidence=0.3, warning="doubtful correspondence", hypothesis="answer", decided_by="placement",
+        placement_used=True, turn_degrees=9.4, runner_up={"hypothesis": "mirror", "cost": 0.07574},
+    )
+    assert shapecorr_meshlab.report(result) == [
+        "confidence 0.30, hypothesis 'answer' decided by placement (placement used), turn 9 degrees, "
+        "runner-up 'mirror' cost 0.07574",
+        "warning: doubtful correspondence",
+        shapecorr_meshlab.ADVICE,
+    ]
+    result = SimpleNamespace(confidence=0.9, warning=None, hypothesis="mirror", decided_by="cost",
+                             placement_used=False, turn_degrees=None, runner_up=None)
+    assert shapecorr_meshlab.report(result) == [
+        "confidence 0.90, hypothesis 'mirror' decided by cost (placement not used), no runner-up"
+    ]
+    unverified = SimpleNamespace(confidence=None, warning=None, hypothesis=None)
+    assert shapecorr_meshlab.report(unverified) == ["not verified"]
 
 
 # ----------------------------------------------------------------------------------- transfer

@@ -72,9 +72,32 @@ pub struct ShapePairArgs {
     /// loose pieces, far vertices or isolated points (each repair made is printed on stderr).
     #[arg(long)]
     pub no_repair: bool,
+    /// Landmark pairs: a text file with a vertex of A, then the vertex of B that corresponds
+    /// to it, on each line (0-based indices of the files' vertices, separated by spaces, tabs
+    /// or one comma; `#` starts a comment). The answer is the one that carries them nearest
+    /// their partners, and in a map (`p2p`, `transfer`) each landmark of B maps exactly to
+    /// its partner; two pairs on one side of a body settle which side is which. See
+    /// docs/placement.md.
+    #[arg(long, value_name = "FILE")]
+    pub landmarks: Option<PathBuf>,
 }
 
 impl ShapePairArgs {
+    /// The landmark pairs of `--landmarks` (none without it), read as
+    /// [`crate::landmarks::read_landmarks`]; the library checks them against the shapes.
+    pub fn landmarks(&self) -> Result<Vec<shapecorr::maps::landmarks::Landmark>, Error> {
+        self.landmarks
+            .as_deref()
+            .map_or(Ok(Vec::new()), crate::landmarks::read_landmarks)
+    }
+
+    /// The files the command reads: A, B and the landmarks file, which no output replaces.
+    pub fn inputs(&self) -> Vec<&Path> {
+        let mut inputs = vec![self.a.as_path(), &self.b];
+        inputs.extend(self.landmarks.as_deref());
+        inputs
+    }
+
     /// Shapes A and B, read as [`read_input`].
     pub fn read(&self) -> Result<(Shape, Shape), Error> {
         Ok((
@@ -103,8 +126,17 @@ impl ShapePairArgs {
         })
     }
 
-    /// An error about shape A or B as one naming its file ([`naming_files`]).
+    /// An error about shape A or B as one naming its file ([`naming_files`]), and one about
+    /// the landmarks as one naming the landmarks file.
     pub fn naming(&self, e: Error) -> Error {
-        naming_files(e, &self.a, &self.b)
+        match (e, &self.landmarks) {
+            (
+                e @ Error::InvalidParameter {
+                    name: "landmarks", ..
+                },
+                Some(file),
+            ) => Error::file(file, e.to_string()),
+            (e, _) => naming_files(e, &self.a, &self.b),
+        }
     }
 }

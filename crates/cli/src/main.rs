@@ -8,6 +8,7 @@
 
 mod commands;
 mod input;
+mod landmarks;
 mod options;
 mod output;
 
@@ -55,8 +56,10 @@ enum Command {
     /// Region correspondence between two shapes: writes DIR/result.json and
     /// DIR/a_regions.ply, DIR/b_regions.ply (matched regions share a colour, unmatched ones
     /// are dark grey). result.json has the answer's confidence (in [0, 1]; null when not
-    /// verified) and the hypotheses it was chosen from; a doubtful answer is also warned
-    /// about on stderr.
+    /// verified), the hypotheses it was chosen from, the chosen one and what decided it, and
+    /// the runner-up, whose answer is written in DIR/other/ (the same files); a doubtful
+    /// answer is also warned about on stderr, with what to do. `--landmarks FILE` and
+    /// `--placement` say what you know (docs/placement.md).
     Match(MatchArgs),
     /// Symmetric regions of one shape (the shape matched to itself): DIR/result.json and a
     /// PLY coloured by symmetry group.
@@ -65,7 +68,8 @@ enum Command {
     /// DIR/map_b_to_a.txt (for every vertex of B, the 0-based index of its vertex on A),
     /// DIR/result.json (the regions as `match`, plus timings), DIR/a_colors.ply (A coloured
     /// by its normalised coordinates) and DIR/b_mapped.ply (B with A's colours carried over
-    /// by the map). The confidence and warning as `match`'s, for the map's answer.
+    /// by the map). The confidence, warning and runner-up as `match`'s, for the map's answer:
+    /// the runner-up's map and colours in DIR/other/.
     P2p(P2pArgs),
     /// Values on A's vertices (a text file, a row per vertex) carried to B's vertices
     /// through the point-to-point map, interpolated on A's surface (`--mode interpolate`),

@@ -5,12 +5,13 @@ use std::path::{Path, PathBuf};
 
 use serde_json::json;
 use shapecorr::colors::{coordinate_colors, region_colors};
-use shapecorr::maps::hypotheses::Verdict;
+use shapecorr::maps::hypotheses::{Decision, HypothesisScore, Verdict};
+use shapecorr::maps::placement::Placement;
 use shapecorr::options::{OptionGroup, OptionValue, Options, OPTIONS};
 use shapecorr::pipeline::Correspondence;
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::regions::graph::ShapeGraph;
-use shapecorr::{Error, Shape};
+use shapecorr::{Error, Params, Shape};
 
 /// `println!` that returns an error instead of panicking when standard output cannot be
 /// written (`> /dev/full`, a full disk). A closed pipe (`| head`) ends the tool quietly
@@ -333,8 +334,12 @@ pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> ser
 
 /// Sets the keys of `result.json` that say how sure the answer is: `confidence` (in [0, 1],
 /// null when the answer was not verified), `doubtful`, `warning` (the verdict's sentence
-/// when doubtful, else null) and `hypotheses` (every hypothesis verified, with its map's
-/// energy and whether it was chosen; empty when not verified).
+/// when doubtful, else null), `hypotheses` (every hypothesis verified, with its map's
+/// energy, the turn it implies, whether it was chosen and whether the placement or the
+/// landmarks ruled it out; empty when not verified), `chosen` (the chosen hypothesis and
+/// what decided it) and `runner_up` (the cheapest other hypothesis giving a different map:
+/// the other answer); the last two are null when not verified, `runner_up` also when no
+/// other hypothesis gives a different map.
 pub fn set_verdict_json(value: &mut serde_json::Value, verdict: Option<&Verdict>) {
     let hypotheses: Vec<serde_json::Value> = verdict
         .map(|v| {
@@ -342,15 +347,14 @@ pub fn set_verdict_json(value: &mut serde_json::Value, verdict: Option<&Verdict>
                 .iter()
                 .enumerate()
                 .map(|(i, s)| {
-                    json!({
-                        "kind": s.kind.name(),
-                        "chosen": i == v.chosen,
-                        "cost": s.energy.cost(),
-                        "distortion": s.energy.distortion,
-                        "coverage": s.energy.coverage,
-                        "orientation": s.energy.orientation,
-                        "residual": s.energy.residual,
-                    })
+                    let mut h = hypothesis_json(s);
+                    h["chosen"] = json!(i == v.chosen);
+                    h["ruled_out"] = json!(v.ruled_out.get(i).copied().unwrap_or(false));
+                    h["distortion"] = json!(s.energy.distortion);
+                    h["coverage"] = json!(s.energy.coverage);
+                    h["orientation"] = json!(s.energy.orientation);
+                    h["residual"] = json!(s.energy.residual);
+                    h
                 })
                 .collect()
         })
@@ -359,6 +363,137 @@ pub fn set_verdict_json(value: &mut serde_json::Value, verdict: Option<&Verdict>
     value["doubtful"] = json!(verdict.is_some_and(Verdict::doubtful));
     value["warning"] = json!(verdict.and_then(Verdict::warning));
     value["hypotheses"] = json!(hypotheses);
+    value["chosen"] = verdict.map_or(serde_json::Value::Null, |v| {
+        let mut chosen = hypothesis_json(v.chosen());
+        chosen["decided_by"] = json!(v.decided_by.name());
+        chosen
+    });
+    value["runner_up"] = verdict
+        .and_then(|v| Some(hypothesis_json(&v.scores[v.runner_up()?])))
+        .unwrap_or_default();
+}
+
+/// A hypothesis as `result.json` names it: its kind, cost ([`MapEnergy::cost`], lower is
+/// better), the rigid turn its map implies between B and A (degrees) and how far it carries
+/// the landmarks from their partners (null without landmarks).
+///
+/// [`MapEnergy::cost`]: shapecorr::maps::hypotheses::MapEnergy::cost
+fn hypothesis_json(score: &HypothesisScore) -> serde_json::Value {
+    json!({
+        "kind": score.kind.name(),
+        "cost": score.energy.cost(),
+        "turn_degrees": score.turn_degrees,
+        "landmark_error": score.landmark_error,
+    })
+}
+
+/// Sets the keys of `result.json` on what the user gave beyond the shapes:
+/// `placement` (`mode`: `auto`, `ignore` or `trust`; `used`: whether the shapes' placement
+/// decided the answer) and `landmarks` (the pairs, A's vertex then B's).
+pub fn set_guidance_json(
+    value: &mut serde_json::Value,
+    params: &Params,
+    verdict: Option<&Verdict>,
+) {
+    value["placement"] = json!({
+        "mode": params.placement.name(),
+        "used": verdict.is_some_and(|v| v.decided_by == Decision::Placement),
+    });
+    value["landmarks"] = json!(params.landmarks);
+}
+
+/// The folder of a command's output folder where the runner-up's answer is written, with
+/// the same files as the answer.
+pub const OTHER_DIR: &str = "other";
+
+/// `names` in [`OTHER_DIR`], for [`create_out_dir`].
+pub fn other_names(names: &[&str]) -> Vec<String> {
+    names.iter().map(|n| format!("{OTHER_DIR}/{n}")).collect()
+}
+
+/// Removes the files `names` of [`OTHER_DIR`] in `out` (and the folder when that leaves it
+/// empty): a result without a runner-up must not sit next to an earlier run's other answer.
+pub fn clear_other(out: &Path, names: &[&str]) -> Result<(), Error> {
+    let dir = out.join(OTHER_DIR);
+    if !dir.is_dir() {
+        return Ok(());
+    }
+    for name in names {
+        let path = dir.join(name);
+        if path.is_file() {
+            std::fs::remove_file(&path).map_err(|e| {
+                Error::file(&path, format!("cannot remove an earlier run's file: {e}"))
+            })?;
+        }
+    }
+    // Only when empty: a file the user put there stays.
+    let _ = std::fs::remove_dir(&dir);
+    Ok(())
+}
+
+/// The summary line on how the answer was chosen (None when it was not verified): the
+/// hypothesis, its cost and turn, what decided it, the placement mode, and the runner-up's
+/// cost and turn, with `other` (where its answer is, or how to get it) when there is one.
+pub fn choice_summary(verdict: Option<&Verdict>, params: &Params, other: &str) -> Option<String> {
+    let v = verdict?;
+    let chosen = v.chosen();
+    let placement = match (params.placement, v.decided_by) {
+        (_, Decision::Placement) => format!("--placement {}: used", params.placement.name()),
+        (mode, _) => format!("--placement {}: not used", mode.name()),
+    };
+    let other = if other.is_empty() {
+        String::new()
+    } else {
+        format!(" {other}")
+    };
+    let runner_up = match v.runner_up().map(|h| &v.scores[h]) {
+        Some(r) => format!(
+            "runner-up: `{}` (cost {:.4}, turn {:.0} degrees){other}",
+            r.kind.name(),
+            r.energy.cost(),
+            r.turn_degrees
+        ),
+        None => "no runner-up (every other hypothesis gives the same map)".to_string(),
+    };
+    Some(format!(
+        "chosen: `{}` hypothesis (cost {:.4}, turn {:.0} degrees), decided by {} ({placement}); \
+         {runner_up}",
+        chosen.kind.name(),
+        chosen.energy.cost(),
+        chosen.turn_degrees,
+        v.decided_by.name(),
+    ))
+}
+
+/// Prints the verdict's warning on stderr when the answer is doubtful ([`print_warning`]),
+/// then a line on what to do about it: `look` (where the runner-up's answer is, or how to
+/// get it) when there is a runner-up, landmarks, and `--placement trust` unless it was.
+pub fn print_doubtful(verdict: Option<&Verdict>, params: &Params, look: &str) {
+    print_warning(verdict);
+    let Some(v) = verdict.filter(|v| v.doubtful()) else {
+        return;
+    };
+    let mut steps = Vec::new();
+    if v.runner_up().is_some() {
+        steps.push(look.to_string());
+    }
+    steps.push(if params.landmarks.is_empty() {
+        "give two landmark pairs with --landmarks FILE (say a left hand and a left foot, a \
+         vertex of A then its partner on B)"
+            .to_string()
+    } else {
+        "give more landmark pairs in the --landmarks file".to_string()
+    });
+    if params.placement != Placement::Trust {
+        steps.push("use --placement trust when the shapes stand alike".to_string());
+    }
+    let last = steps.pop().unwrap_or_default();
+    let steps = if steps.is_empty() {
+        last
+    } else {
+        format!("{}, or {last}", steps.join(", "))
+    };
+    errln!("shapecorr: to check or correct it: {steps} (docs/placement.md)");
 }
 
 /// How sure the answer is, for the one-line summary: `confidence 0.93`, `confidence 0.31,

@@ -11,8 +11,9 @@ use shapecorr::Error;
 use crate::input::{read_input, ShapePairArgs};
 use crate::options::RegionOptions;
 use crate::output::{
-    budget_json, confidence_summary, correspondence_json, create_out_dir, end_progress_line,
-    graph_json, options_json, print_warning, write_colored, write_json, TerminalProgress,
+    budget_json, choice_summary, clear_other, confidence_summary, correspondence_json, create_dir,
+    create_out_dir, end_progress_line, graph_json, options_json, other_names, print_doubtful,
+    set_guidance_json, write_colored, write_json, TerminalProgress, OTHER_DIR,
 };
 
 /// The files `match` writes into its folder.
@@ -32,8 +33,12 @@ pub struct MatchArgs {
 impl MatchArgs {
     pub fn run(&self) -> Result<(), Error> {
         let mut options = self.options.options()?;
+        options.params.landmarks = self.pair.landmarks()?;
         let out = &self.out;
-        create_out_dir(out, &MATCH_FILES, &[&self.pair.a, &self.pair.b])?;
+        let mut names: Vec<String> = MATCH_FILES.iter().map(|n| n.to_string()).collect();
+        names.extend(other_names(&MATCH_FILES));
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        create_out_dir(out, &names, &self.pair.inputs())?;
         let mut progress = TerminalProgress::new();
         let mut budget = options.params.budget.clone();
         let job = PairJob {
@@ -50,13 +55,29 @@ impl MatchArgs {
         let result = Correspondence::compute(&shape_a, &shape_b, &options.params, &mut progress);
         end_progress_line();
         let result = result.map_err(|e| self.pair.naming(e))?;
-        let mut value = correspondence_json(&shape_a, &shape_b, &result);
-        value["options"] = options_json(&options, false);
-        if let Some(estimate) = &result.estimate {
-            value["budget"] = budget_json(estimate);
-        }
+        let other = result.other_answer();
+        let json = |result: &Correspondence, other: Option<&str>| {
+            let mut value = correspondence_json(&shape_a, &shape_b, result);
+            set_guidance_json(&mut value, &options.params, result.verdict.as_ref());
+            value["other_answer"] = json!(other);
+            value["options"] = options_json(&options, false);
+            if let Some(estimate) = &result.estimate {
+                value["budget"] = budget_json(estimate);
+            }
+            value
+        };
+        let value = json(&result, other.as_ref().map(|_| OTHER_DIR));
         write_json(&out.join("result.json"), &value)?;
         write_colored(out, &shape_a, &shape_b, &result)?;
+        let other_dir = out.join(OTHER_DIR);
+        match &other {
+            Some(other) => {
+                create_dir(&other_dir)?;
+                write_json(&other_dir.join("result.json"), &json(other, None))?;
+                write_colored(&other_dir, &shape_a, &shape_b, other)?;
+            }
+            None => clear_other(out, &MATCH_FILES)?,
+        }
         outln!(
             "k = {}: {} regions on A, {} on B; {} symmetric matches, {} one-to-one ({}); {:.2} s -> {}",
             result.k,
@@ -68,7 +89,16 @@ impl MatchArgs {
             result.timings.total,
             out.display()
         )?;
-        print_warning(result.verdict.as_ref());
+        let verdict = result.verdict.as_ref();
+        let where_other = format!("-> {}", other_dir.display());
+        if let Some(line) = choice_summary(verdict, &options.params, &where_other) {
+            outln!("{line}")?;
+        }
+        let look = format!(
+            "look at {} (the runner-up's one-to-one regions)",
+            other_dir.display()
+        );
+        print_doubtful(verdict, &options.params, &look);
         Ok(())
     }
 }

@@ -12,8 +12,8 @@ use shapecorr::PointwiseCorrespondence;
 use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
 use crate::output::{
-    check_output_file, confidence_summary, end_progress_line, outln, print_warning, refuse_inputs,
-    write_files, TerminalProgress,
+    check_output_file, choice_summary, confidence_summary, end_progress_line, outln,
+    print_doubtful, refuse_inputs, write_files, TerminalProgress,
 };
 
 /// How the values are carried (the library's `TransferMode`).
@@ -49,6 +49,11 @@ pub struct TransferArgs {
     /// vertices of A and their three weights (`a0 a1 a2 w0 w1 w2`).
     #[arg(long)]
     surface_map: Option<PathBuf>,
+    /// Carry the values through the runner-up hypothesis's map instead of the chosen one:
+    /// the other answer (`p2p` writes it in `OUT/other/`), for when the first transfer came
+    /// out swapped or mirrored. Fails when no other hypothesis gives a different map.
+    #[arg(long)]
+    other_answer: bool,
     #[command(flatten)]
     options: PointwiseOptions,
 }
@@ -69,10 +74,12 @@ fn influences(text: &str) -> Result<usize, String> {
 
 impl TransferArgs {
     pub fn run(&self) -> Result<(), Error> {
-        let (options, pointwise) = self.options.pointwise()?;
+        let (mut options, pointwise) = self.options.pointwise()?;
+        options.params.landmarks = self.pair.landmarks()?;
         let mut outputs = vec![self.out.as_path()];
         outputs.extend(self.surface_map.as_deref());
-        let inputs = [self.pair.a.as_path(), &self.pair.b, &self.values];
+        let mut inputs = self.pair.inputs();
+        inputs.push(&self.values);
         refuse_inputs(&outputs, &inputs)?;
         for path in &outputs {
             check_output_file(path)?;
@@ -88,6 +95,19 @@ impl TransferArgs {
             &mut progress,
         )
         .and_then(|result| {
+            let result = if self.other_answer {
+                result
+                    .other_answer()
+                    .ok_or_else(|| Error::InvalidParameter {
+                        name: "other_answer",
+                        reason:
+                            "no other hypothesis gives a different map: the answer is the only \
+                             one (see `shapecorr p2p`'s result.json, `runner_up`)"
+                                .into(),
+                    })?
+            } else {
+                result
+            };
             let onto =
                 SurfaceMap::from_vertex_map(&shape_a, &shape_b, &result.map.p2p_ba, &mut progress)?;
             Ok((result, onto))
@@ -121,7 +141,21 @@ impl TransferArgs {
             result.total,
             self.out.display()
         )?;
-        print_warning(result.verdict());
+        let params = &options.params;
+        let other = if self.other_answer {
+            ""
+        } else {
+            "(--other-answer carries the values through its map)"
+        };
+        if let Some(line) = choice_summary(result.verdict(), params, other) {
+            outln!("{line}")?;
+        }
+        let look = if self.other_answer {
+            "run without --other-answer to go back to the first answer"
+        } else {
+            "carry the values through the runner-up's map with --other-answer"
+        };
+        print_doubtful(result.verdict(), params, look);
         Ok(())
     }
 }

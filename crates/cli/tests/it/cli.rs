@@ -450,7 +450,7 @@ fn help_lists_one_flag_per_option_of_the_table() {
     for (command, own) in [
         (
             &["match", "--help"][..],
-            &["--out", "--points", "--no-repair"][..],
+            &["--out", "--points", "--no-repair", "--landmarks"][..],
         ),
         (
             &["symmetry", "--help"],

@@ -7,5 +7,6 @@ mod bench_all;
 mod cli;
 mod common;
 mod files;
+mod guidance;
 mod hostile;
 mod memory_cap;
