@@ -169,7 +169,8 @@ pub fn frame_pick(mode: Placement, view: &FrameView<'_>) -> Option<usize> {
         }
         Placement::Auto => {
             let near = |h: usize| competitive(h) && turns[h] <= NEAR_TURN;
-            let pick = cheapest_of(&|h| near(h) && !from_frame(h)).or_else(|| cheapest_of(&near))?;
+            let pick =
+                cheapest_of(&|h| near(h) && !from_frame(h)).or_else(|| cheapest_of(&near))?;
             let undecided = (0..n).any(|h| {
                 !from_frame(h) && different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN
             });
@@ -257,9 +258,15 @@ mod tests {
             different: &differ,
         };
         // The frame's own map is cheaper, but a region answer stands near it.
-        assert_eq!(frame_pick(Placement::Auto, &view(&[170.0, 10.0, 5.0])), Some(1));
+        assert_eq!(
+            frame_pick(Placement::Auto, &view(&[170.0, 10.0, 5.0])),
+            Some(1)
+        );
         // No region answer near no turn: the frame's own map.
-        assert_eq!(frame_pick(Placement::Auto, &view(&[170.0, 175.0, 5.0])), Some(2));
+        assert_eq!(
+            frame_pick(Placement::Auto, &view(&[170.0, 175.0, 5.0])),
+            Some(2)
+        );
     }
 
     #[test]
@@ -281,37 +288,19 @@ mod tests {
         };
         let costs = [1.0, 1.1, 1.2];
         // The cheapest answer is half-turned, a near-identity rival within the cost ratio.
-        assert_eq!(
-            pick(Placement::Auto, &[178.0, 5.0, 160.0], &costs),
-            Some(1)
-        );
+        assert_eq!(pick(Placement::Auto, &[178.0, 5.0, 160.0], &costs), Some(1));
         // An answer between the two thresholds: undecided.
-        assert_eq!(
-            pick(Placement::Auto, &[60.0, 5.0, 160.0], &costs),
-            None
-        );
+        assert_eq!(pick(Placement::Auto, &[60.0, 5.0, 160.0], &costs), None);
         // No answer near no turn (shapes turned at random): nothing.
-        assert_eq!(
-            pick(Placement::Auto, &[120.0, 140.0, 160.0], &costs),
-            None
-        );
+        assert_eq!(pick(Placement::Auto, &[120.0, 140.0, 160.0], &costs), None);
         // Too costly to be picked.
-        assert_eq!(
-            pick(Placement::Auto, &[178.0, 5.0], &[1.0, 3.5]),
-            None
-        );
+        assert_eq!(pick(Placement::Auto, &[178.0, 5.0], &[1.0, 3.5]), None);
         assert_eq!(
             pick(Placement::Trust, &[120.0, 60.0, 160.0], &costs),
             Some(1)
         );
         // Trust: two answers of about the same least turn, the cheaper one.
-        assert_eq!(
-            pick(Placement::Trust, &[9.0, 8.0, 160.0], &costs),
-            Some(0)
-        );
-        assert_eq!(
-            pick(Placement::Ignore, &[178.0, 5.0, 160.0], &costs),
-            None
-        );
+        assert_eq!(pick(Placement::Trust, &[9.0, 8.0, 160.0], &costs), Some(0));
+        assert_eq!(pick(Placement::Ignore, &[178.0, 5.0, 160.0], &costs), None);
     }
 }
