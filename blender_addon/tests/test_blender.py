@@ -742,8 +742,8 @@ def test_a_bad_landmark_is_reported_and_leaves_the_scene_unchanged(addon, operat
 def test_the_placement_setting_reaches_the_library(addon, placement, used):
     """Trust always takes the answer of least turn (the placement is used), Ignore never: the
     panel's summary says which, as the library's own result with that setting does."""
-    settings = bpy.context.scene.shapecorr
     a, b = two_figures(addon)
+    settings = bpy.context.scene.shapecorr  # after the new scene: the old one is freed
     settings.placement = placement
     try:
         assert settings.library_options()["placement"] == placement
