@@ -838,3 +838,72 @@ def test_use_other_answer_says_when_there_is_none(addon):
     bpy.context.view_layer.update()
     with pytest.raises(RuntimeError, match="changed since the last run"):
         bpy.ops.shapecorr.other_answer()
+
+
+class RecordingLayout:
+    """Stands in for a panel's layout (headless Blender draws no panel): records the labels,
+    properties and operators drawn, in order."""
+
+    def __init__(self, record=None):
+        self.record = [] if record is None else record
+        self.enabled = True
+
+    def _sub(self, *args, **kwargs):
+        return RecordingLayout(self.record)
+
+    column = row = box = split = _sub
+
+    def label(self, text="", icon="NONE"):
+        self.record.append(("label", text))
+
+    def prop(self, data, name, **kwargs):
+        assert hasattr(data, name), name
+        self.record.append(("prop", name))
+
+    def operator(self, idname, **kwargs):
+        category, name = idname.split(".")
+        assert hasattr(getattr(bpy.ops, category), name), idname
+        self.record.append(("operator", idname))
+
+    def template_list(self, list_type, list_id, data, name, active_data, active_name, **kwargs):
+        assert hasattr(bpy.types, list_type), list_type
+        assert hasattr(data, name) and hasattr(active_data, active_name)
+        self.record.append(("list", name))
+
+
+def draw_panels(addon):
+    """What every panel of the add-on draws now, as RecordingLayout records."""
+    layout = RecordingLayout()
+    panel = addon.panel
+    for cls in (panel.SHAPECORR_PT_panel, panel.SHAPECORR_PT_answer, panel.SHAPECORR_PT_landmarks,
+                panel.SHAPECORR_PT_transfer):
+        fake = type("Panel", (), {"layout": layout})()
+        cls.draw(fake, bpy.context)
+    return layout.record
+
+
+def test_the_panel_shows_the_answer_the_buttons_and_the_landmarks(addon):
+    a, b = two_figures(addon)
+    drawn = draw_panels(addon)
+    assert ("prop", "placement") in drawn
+    for idname in ("shapecorr.show_map", "shapecorr.other_answer", "shapecorr.landmark_add",
+                   "shapecorr.landmark_remove", "shapecorr.landmark_clear"):
+        assert ("operator", idname) in drawn, idname
+    assert ("list", "landmarks") in drawn
+    assert ("label", "No answer yet") in drawn
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    expected = addon.shapecorr.match(world_shape(addon, a), world_shape(addon, b))
+    labels = [text for kind, text in draw_panels(addon) if kind == "label"]
+    assert "Match Regions: A \u2192 B" in labels, labels
+    assert f"Confidence {expected.confidence:.2f}" in labels, labels
+    assert f"Answer: {expected.hypothesis} (by {expected.decided_by})" in labels, labels
+    placement = [t for t in labels if t.startswith("Placement: ")]
+    assert placement == [f"Placement: {'used' if expected.placement_used else 'not used'}, "
+                         f"turn {expected.turn_degrees:.0f}\u00b0"], labels
+    runner_up = expected.runner_up
+    if runner_up is None:
+        assert "Runner-up: none" in labels, labels
+    else:
+        field = memory_module()._field
+        text = f"Runner-up: {field(runner_up, 'hypothesis')}, cost {field(runner_up, 'cost'):.3g}"
+        assert text in labels, labels
