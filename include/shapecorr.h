@@ -101,6 +101,20 @@
 // A boolean option (`sc_params_set_bool`).
 #define SC_OPTION_BOOL 2
 
+// Option `placement`: use where the shapes stand only when it is informative (the default;
+// docs/placement.md).
+#define SC_PLACEMENT_AUTO 0
+
+// Option `placement`: never use where the shapes stand (the intrinsic answer).
+#define SC_PLACEMENT_IGNORE 1
+
+// Option `placement`: the shapes stand alike (one scene, one scanner rig); among the
+// consistent answers, the one that implies the least turn is taken.
+#define SC_PLACEMENT_TRUST 2
+
+// Most landmark pairs `sc_params_set_landmarks` accepts.
+#define SC_MAX_LANDMARKS 100
+
 // Option `p2p_regions`: no region constraint (then `p2p_wks` must be true).
 #define SC_P2P_REGIONS_NONE 0
 
@@ -145,6 +159,13 @@
 // Transfer mode: skin weights (interpolated, at most `max_influences` kept, each row of B
 // scaled to sum to 1; A's values must be non-negative).
 #define SC_TRANSFER_WEIGHTS 2
+
+// The hypothesis chosen (`sc_correspondence_hypothesis`, `sc_pointwise_hypothesis`).
+#define SC_ANSWER_CHOSEN 0
+
+// The runner-up: the cheapest other definite hypothesis whose map differs from the chosen
+// one, the answer `sc_correspondence_other_answer` and `sc_pointwise_other_answer` give.
+#define SC_ANSWER_RUNNER_UP 1
 
 // Status of every fallible call. The numbers never change meaning; new codes are added.
 enum sc_status
@@ -534,6 +555,65 @@ double sc_correspondence_confidence(const sc_correspondence *correspondence);
 // `correspondence` must be NULL or live.
 const char *sc_correspondence_warning(const sc_correspondence *correspondence);
 
+// The name of a verified hypothesis: `which` is `SC_ANSWER_CHOSEN` (the answer returned) or
+// `SC_ANSWER_RUNNER_UP` (the cheapest other hypothesis whose map differs, the one
+// `sc_correspondence_other_answer` gives). Names: `"answer"`, `"mirror"`, `"symmetric"`,
+// `"alternative N"`, `"placement"` (docs/placement.md). NULL when the answer was not
+// verified (`sc_correspondence_confidence` is NaN), when there is no runner-up, and for
+// NULL or a bad `which`. The string belongs to `correspondence`: valid until it is freed.
+//
+// # Safety
+// `correspondence` must be NULL or live.
+const char *sc_correspondence_hypothesis(const sc_correspondence *correspondence, uint32_t which);
+
+// The cost of hypothesis `which` (`SC_ANSWER_CHOSEN` or `SC_ANSWER_RUNNER_UP`): its map's
+// distortion divided by the square of its coverage times the orientation kept; lower is
+// better. NaN when there is no such hypothesis (as `sc_correspondence_hypothesis`).
+//
+// # Safety
+// `correspondence` must be NULL or live.
+double sc_correspondence_hypothesis_cost(const sc_correspondence *correspondence, uint32_t which);
+
+// The rigid turn, in degrees (0 to 180), that the map of hypothesis `which`
+// (`SC_ANSWER_CHOSEN` or `SC_ANSWER_RUNNER_UP`) implies between B as placed and A: near 0
+// when the map agrees with where the shapes stand, near 180 for a half-turn. NaN when there
+// is no such hypothesis (as `sc_correspondence_hypothesis`).
+//
+// # Safety
+// `correspondence` must be NULL or live.
+double sc_correspondence_turn_degrees(const sc_correspondence *correspondence, uint32_t which);
+
+// What settled the choice among the hypotheses (static; never free it): `"cost"` (the
+// cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
+// stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
+// (a result of `sc_correspondence_other_answer`). NULL when the answer was not verified,
+// and for NULL.
+//
+// # Safety
+// `correspondence` must be NULL or live.
+const char *sc_correspondence_decided_by(const sc_correspondence *correspondence);
+
+// True when the shapes' placement settled the choice (`sc_correspondence_decided_by` is
+// `"placement"`); false otherwise, and for NULL.
+//
+// # Safety
+// `correspondence` must be NULL or live.
+bool sc_correspondence_placement_used(const sc_correspondence *correspondence);
+
+// The other answer: a new correspondence whose one-to-one matches are the runner-up
+// hypothesis's (`sc_correspondence_hypothesis(c, SC_ANSWER_RUNNER_UP)`), with its verdict
+// (decided by `"other answer"`; its runner-up is usually the first answer). Nothing is
+// recomputed: the hypotheses were verified with the first answer. The caller frees it with
+// `sc_correspondence_free`; it is independent of `correspondence`.
+//
+// Errors: `SC_STATUS_INVALID_ARGUMENT` when there is no other answer (the answer was not
+// verified, or no other hypothesis gives a different map; `sc_last_error` says which).
+//
+// # Safety
+// `correspondence` must be live; `out_correspondence` writable.
+sc_status sc_correspondence_other_answer(const sc_correspondence *correspondence,
+                                         sc_correspondence **out_correspondence);
+
 // New parameters with the documented defaults.
 //
 // # Safety
@@ -589,6 +669,36 @@ sc_status sc_params_get_double(const sc_params *params, const char *name, double
 // # Safety
 // `params` must be live parameters; `name` a NUL-terminated string; `out_value` writable.
 sc_status sc_params_get_bool(const sc_params *params, const char *name, bool *out_value);
+
+// Sets the landmarks: `n_pairs` pairs of vertices known to correspond, `pairs[2 i]` a vertex
+// of A (the first shape given to `sc_match` or `sc_pointwise_map`) and `pairs[2 i + 1]` its
+// partner on B, 0-based input indices (docs/placement.md). They replace those set before;
+// `n_pairs` 0 clears them (`pairs` may then be NULL). Every landmark of B maps exactly to its
+// partner in the pointwise map, and the region answer is chosen to agree with them: two
+// pairs on one side of a body settle every symmetric choice. They are copied.
+//
+// Errors: `SC_STATUS_NULL_ARGUMENT` (`params`, or `pairs` with `n_pairs` above 0),
+// `SC_STATUS_INVALID_PARAMETER` (more than `SC_MAX_LANDMARKS` pairs). Checked against the
+// shapes when a job starts, where a failure is `SC_STATUS_INVALID_PARAMETER` with
+// `sc_last_error` naming the pair: a vertex past the end of its shape, one the repairs left
+// out, one vertex given two partners.
+//
+// # Safety
+// `params` must be live parameters; `pairs` NULL or `2 * n_pairs` readable values.
+sc_status sc_params_set_landmarks(sc_params *params, const uint32_t *pairs, size_t n_pairs);
+
+// Number of landmark pairs set (`sc_params_set_landmarks`); 0 for NULL.
+//
+// # Safety
+// `params` must be NULL or live parameters.
+size_t sc_params_n_landmarks(const sc_params *params);
+
+// Copies the landmark pairs as `a0 b0 a1 b1 ...` (`2 * sc_params_n_landmarks` values, in
+// the order set) into `out_pairs` of `len` elements.
+//
+// # Safety
+// `params` must be live parameters; `out_pairs` must point to `len` writable elements.
+sc_status sc_params_landmarks(const sc_params *params, uint32_t *out_pairs, size_t len);
 
 // Number of options; they are numbered `0 .. sc_option_count() - 1` in a stable order
 // (new options are appended).
@@ -725,6 +835,55 @@ double sc_pointwise_confidence(const sc_pointwise *pointwise);
 // # Safety
 // `pointwise` must be NULL or live.
 const char *sc_pointwise_warning(const sc_pointwise *pointwise);
+
+// The name of a verified hypothesis, for the verdict behind `sc_pointwise_confidence` (as
+// `sc_correspondence_hypothesis`: `which` is `SC_ANSWER_CHOSEN` or `SC_ANSWER_RUNNER_UP`;
+// NULL when there is none). The string belongs to `pointwise`: valid until it is freed.
+//
+// # Safety
+// `pointwise` must be NULL or live.
+const char *sc_pointwise_hypothesis(const sc_pointwise *pointwise, uint32_t which);
+
+// The cost of hypothesis `which` (as `sc_correspondence_hypothesis_cost`; NaN when there is
+// none).
+//
+// # Safety
+// `pointwise` must be NULL or live.
+double sc_pointwise_hypothesis_cost(const sc_pointwise *pointwise, uint32_t which);
+
+// The rigid turn, in degrees, that the map of hypothesis `which` implies between B as
+// placed and A (as `sc_correspondence_turn_degrees`; NaN when there is none).
+//
+// # Safety
+// `pointwise` must be NULL or live.
+double sc_pointwise_turn_degrees(const sc_pointwise *pointwise, uint32_t which);
+
+// What settled the choice among the hypotheses (as `sc_correspondence_decided_by`; static,
+// NULL when nothing was verified).
+//
+// # Safety
+// `pointwise` must be NULL or live.
+const char *sc_pointwise_decided_by(const sc_pointwise *pointwise);
+
+// True when the shapes' placement settled the choice (`sc_pointwise_decided_by` is
+// `"placement"`); false otherwise, and for NULL.
+//
+// # Safety
+// `pointwise` must be NULL or live.
+bool sc_pointwise_placement_used(const sc_pointwise *pointwise);
+
+// The other answer: a new pointwise map holding the runner-up hypothesis's vertex map (at
+// full resolution), functional map and one-to-one regions, with its verdict (decided by
+// `"other answer"`). Nothing is recomputed: the hypotheses were verified with the first
+// answer. Every accessor, `sc_surface_map_new` (with the same two shapes) included, works on
+// it; the caller frees it with `sc_pointwise_free`, independently of `pointwise`.
+//
+// Errors: `SC_STATUS_INVALID_ARGUMENT` when there is no other answer (nothing was verified,
+// or no other hypothesis gives a different map; `sc_last_error` says which).
+//
+// # Safety
+// `pointwise` must be live; `out_pointwise` writable.
+sc_status sc_pointwise_other_answer(const sc_pointwise *pointwise, sc_pointwise **out_pointwise);
 
 // A triangle mesh from `n_vertices` points `xyz = x0 y0 z0 x1 y1 z1 ...` (doubles, packed,
 // 3 per vertex) and `n_triangles` triangles `triangles = a0 b0 c0 a1 ...` (0-based vertex

@@ -1,6 +1,6 @@
 //! Region correspondence between two shapes: `sc_match` and the result's accessors.
 
-use std::ffi::{c_char, c_void, CStr, CString};
+use std::ffi::{c_char, c_void};
 
 use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
@@ -8,8 +8,8 @@ use super::boundary::{
 };
 use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
+use super::verdict::{self, VerdictText};
 use super::{CallbackProgress, ScProgressCallback};
-use crate::maps::hypotheses::Verdict;
 use crate::pipeline::Correspondence;
 use crate::regions::graph::ShapeGraph;
 
@@ -17,28 +17,16 @@ use crate::regions::graph::ShapeGraph;
 /// once. Free it with `sc_correspondence_free`.
 pub struct ScCorrespondence {
     pub(crate) result: Correspondence,
-    /// The verdict's warning, made once with the handle: what `sc_correspondence_warning`
-    /// points into.
-    warning: Option<CString>,
+    /// The verdict's warning and hypothesis names, made once with the handle: what
+    /// `sc_correspondence_warning` and `sc_correspondence_hypothesis` point into.
+    text: VerdictText,
 }
 
 impl ScCorrespondence {
     pub(crate) fn new(result: Correspondence) -> Self {
-        let warning = warning_text(result.verdict.as_ref());
-        ScCorrespondence { result, warning }
+        let text = VerdictText::new(result.verdict.as_ref());
+        ScCorrespondence { result, text }
     }
-}
-
-/// A verdict's warning ([`Verdict::warning`]) as a C string: None when there is no verdict
-/// or the answer is not doubtful.
-pub(crate) fn warning_text(verdict: Option<&Verdict>) -> Option<CString> {
-    let text = verdict?.warning()?;
-    CString::new(text.replace('\0', " ")).ok()
-}
-
-/// The pointer a `_warning` accessor returns: the handle's own string, or NULL.
-pub(crate) fn warning_ptr(warning: &Option<CString>) -> *const c_char {
-    warning.as_deref().map_or(std::ptr::null(), CStr::as_ptr)
 }
 
 /// Side A: the first shape given to `sc_match`.
@@ -422,17 +410,132 @@ pub unsafe extern "C" fn sc_correspondence_warning(
     correspondence: *const ScCorrespondence,
 ) -> *const c_char {
     boundary_value(std::ptr::null(), || {
-        Ok(warning_ptr(
-            &handle(correspondence, "correspondence")?.warning,
-        ))
+        Ok(handle(correspondence, "correspondence")?.text.warning())
+    })
+}
+
+/// The name of a verified hypothesis: `which` is `SC_ANSWER_CHOSEN` (the answer returned) or
+/// `SC_ANSWER_RUNNER_UP` (the cheapest other hypothesis whose map differs, the one
+/// `sc_correspondence_other_answer` gives). Names: `"answer"`, `"mirror"`, `"symmetric"`,
+/// `"alternative N"`, `"placement"` (docs/placement.md). NULL when the answer was not
+/// verified (`sc_correspondence_confidence` is NaN), when there is no runner-up, and for
+/// NULL or a bad `which`. The string belongs to `correspondence`: valid until it is freed.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_hypothesis(
+    correspondence: *const ScCorrespondence,
+    which: u32,
+) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        handle(correspondence, "correspondence")?.text.name(which)
+    })
+}
+
+/// The cost of hypothesis `which` (`SC_ANSWER_CHOSEN` or `SC_ANSWER_RUNNER_UP`): its map's
+/// distortion divided by the square of its coverage times the orientation kept; lower is
+/// better. NaN when there is no such hypothesis (as `sc_correspondence_hypothesis`).
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_hypothesis_cost(
+    correspondence: *const ScCorrespondence,
+    which: u32,
+) -> f64 {
+    boundary_value(f64::NAN, || {
+        let c = handle(correspondence, "correspondence")?;
+        verdict::hypothesis_value(c.result.verdict.as_ref(), which, |h| h.energy.cost())
+    })
+}
+
+/// The rigid turn, in degrees (0 to 180), that the map of hypothesis `which`
+/// (`SC_ANSWER_CHOSEN` or `SC_ANSWER_RUNNER_UP`) implies between B as placed and A: near 0
+/// when the map agrees with where the shapes stand, near 180 for a half-turn. NaN when there
+/// is no such hypothesis (as `sc_correspondence_hypothesis`).
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_turn_degrees(
+    correspondence: *const ScCorrespondence,
+    which: u32,
+) -> f64 {
+    boundary_value(f64::NAN, || {
+        let c = handle(correspondence, "correspondence")?;
+        verdict::hypothesis_value(c.result.verdict.as_ref(), which, |h| h.turn_degrees)
+    })
+}
+
+/// What settled the choice among the hypotheses (static; never free it): `"cost"` (the
+/// cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
+/// stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
+/// (a result of `sc_correspondence_other_answer`). NULL when the answer was not verified,
+/// and for NULL.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_decided_by(
+    correspondence: *const ScCorrespondence,
+) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        let c = handle(correspondence, "correspondence")?;
+        Ok(verdict::decided_by(c.result.verdict.as_ref()))
+    })
+}
+
+/// True when the shapes' placement settled the choice (`sc_correspondence_decided_by` is
+/// `"placement"`); false otherwise, and for NULL.
+///
+/// # Safety
+/// `correspondence` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_placement_used(
+    correspondence: *const ScCorrespondence,
+) -> bool {
+    boundary_value(false, || {
+        let c = handle(correspondence, "correspondence")?;
+        Ok(verdict::placement_used(c.result.verdict.as_ref()))
+    })
+}
+
+/// The other answer: a new correspondence whose one-to-one matches are the runner-up
+/// hypothesis's (`sc_correspondence_hypothesis(c, SC_ANSWER_RUNNER_UP)`), with its verdict
+/// (decided by `"other answer"`; its runner-up is usually the first answer). Nothing is
+/// recomputed: the hypotheses were verified with the first answer. The caller frees it with
+/// `sc_correspondence_free`; it is independent of `correspondence`.
+///
+/// Errors: `SC_STATUS_INVALID_ARGUMENT` when there is no other answer (the answer was not
+/// verified, or no other hypothesis gives a different map; `sc_last_error` says which).
+///
+/// # Safety
+/// `correspondence` must be live; `out_correspondence` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_other_answer(
+    correspondence: *const ScCorrespondence,
+    out_correspondence: *mut *mut ScCorrespondence,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_correspondence, "out_correspondence")?;
+        let c = handle(correspondence, "correspondence")?;
+        let other = c
+            .result
+            .other_answer()
+            .ok_or_else(|| verdict::no_other_answer(c.result.verdict.as_ref()))?;
+        give_handle(out_correspondence, ScCorrespondence::new(other))
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::maps::hypotheses::{HypothesisKind, HypothesisScore, MapEnergy, DOUBTFUL_BELOW};
+    use crate::maps::hypotheses::{
+        HypothesisKind, HypothesisScore, MapEnergy, Verdict, DOUBTFUL_BELOW,
+    };
     use crate::pipeline::Timings;
+    use std::ffi::CStr;
 
     #[test]
     fn header_threshold_matches_the_verdicts() {

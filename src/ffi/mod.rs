@@ -26,6 +26,7 @@ mod pointwise;
 mod shape;
 mod symmetry;
 mod transfer;
+mod verdict;
 
 pub use batch::*;
 pub use boundary::{sc_last_error, sc_status_str, ScStatus};
@@ -35,6 +36,7 @@ pub use pointwise::*;
 pub use shape::*;
 pub use symmetry::*;
 pub use transfer::*;
+pub use verdict::{SC_ANSWER_CHOSEN, SC_ANSWER_RUNNER_UP};
 
 use std::ffi::{c_char, c_void};
 

@@ -6,7 +6,8 @@ use std::ffi::{c_char, CString};
 use std::sync::OnceLock;
 
 use super::boundary::{
-    boundary, check_out, free_handle, give_handle, handle, input_str, Failure, FfiResult, ScStatus,
+    boundary, boundary_value, check_out, free_handle, give_handle, handle, input_slice, input_str,
+    write_output, Failure, FfiResult, ScStatus,
 };
 use crate::options::{option_info, OptionType, OptionValue, Options, OPTIONS};
 use crate::pipeline::Params;
@@ -25,6 +26,17 @@ pub const SC_OPTION_INT: u32 = 0;
 pub const SC_OPTION_DOUBLE: u32 = 1;
 /// A boolean option (`sc_params_set_bool`).
 pub const SC_OPTION_BOOL: u32 = 2;
+
+/// Option `placement`: use where the shapes stand only when it is informative (the default;
+/// docs/placement.md).
+pub const SC_PLACEMENT_AUTO: i64 = 0;
+/// Option `placement`: never use where the shapes stand (the intrinsic answer).
+pub const SC_PLACEMENT_IGNORE: i64 = 1;
+/// Option `placement`: the shapes stand alike (one scene, one scanner rig); among the
+/// consistent answers, the one that implies the least turn is taken.
+pub const SC_PLACEMENT_TRUST: i64 = 2;
+/// Most landmark pairs `sc_params_set_landmarks` accepts.
+pub const SC_MAX_LANDMARKS: usize = 100;
 
 /// New parameters with the documented defaults.
 ///
@@ -216,6 +228,81 @@ pub unsafe extern "C" fn sc_params_get_bool(
     })
 }
 
+/// Sets the landmarks: `n_pairs` pairs of vertices known to correspond, `pairs[2 i]` a vertex
+/// of A (the first shape given to `sc_match` or `sc_pointwise_map`) and `pairs[2 i + 1]` its
+/// partner on B, 0-based input indices (docs/placement.md). They replace those set before;
+/// `n_pairs` 0 clears them (`pairs` may then be NULL). Every landmark of B maps exactly to its
+/// partner in the pointwise map, and the region answer is chosen to agree with them: two
+/// pairs on one side of a body settle every symmetric choice. They are copied.
+///
+/// Errors: `SC_STATUS_NULL_ARGUMENT` (`params`, or `pairs` with `n_pairs` above 0),
+/// `SC_STATUS_INVALID_PARAMETER` (more than `SC_MAX_LANDMARKS` pairs). Checked against the
+/// shapes when a job starts, where a failure is `SC_STATUS_INVALID_PARAMETER` with
+/// `sc_last_error` naming the pair: a vertex past the end of its shape, one the repairs left
+/// out, one vertex given two partners.
+///
+/// # Safety
+/// `params` must be live parameters; `pairs` NULL or `2 * n_pairs` readable values.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_set_landmarks(
+    params: *mut ScParams,
+    pairs: *const u32,
+    n_pairs: usize,
+) -> ScStatus {
+    boundary(|| {
+        let params = params.as_mut().ok_or_else(|| Failure::null("params"))?;
+        if n_pairs > SC_MAX_LANDMARKS {
+            return Err(crate::Error::InvalidParameter {
+                name: "landmarks",
+                reason: format!(
+                    "{n_pairs} pairs given, at most {SC_MAX_LANDMARKS} (SC_MAX_LANDMARKS) are \
+                     accepted"
+                ),
+            }
+            .into());
+        }
+        let flat = input_slice(pairs, 2 * n_pairs, "pairs")?;
+        params.options.params.landmarks = flat.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+        Ok(())
+    })
+}
+
+/// Number of landmark pairs set (`sc_params_set_landmarks`); 0 for NULL.
+///
+/// # Safety
+/// `params` must be NULL or live parameters.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_n_landmarks(params: *const ScParams) -> usize {
+    boundary_value(0, || {
+        Ok(handle(params, "params")?.options.params.landmarks.len())
+    })
+}
+
+/// Copies the landmark pairs as `a0 b0 a1 b1 ...` (`2 * sc_params_n_landmarks` values, in
+/// the order set) into `out_pairs` of `len` elements.
+///
+/// # Safety
+/// `params` must be live parameters; `out_pairs` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_params_landmarks(
+    params: *const ScParams,
+    out_pairs: *mut u32,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let params = handle(params, "params")?;
+        let flat: Vec<u32> = params
+            .options
+            .params
+            .landmarks
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        write_output(out_pairs, len, &flat, "out_pairs")
+    })
+}
+
 /// The C strings of one option: its name, its description and its choices' names.
 struct OptionStrings {
     name: CString,
@@ -312,4 +399,29 @@ pub(crate) unsafe fn options_or_default(params: *const ScParams) -> Options {
     params
         .as_ref()
         .map_or_else(Options::default, |p| p.options.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::maps::placement::Placement;
+    use crate::options::OPTIONS;
+
+    #[test]
+    fn header_placement_constants_match_the_option() {
+        let option = OPTIONS.iter().find(|o| o.name == "placement").unwrap();
+        for (value, placement) in [
+            (SC_PLACEMENT_AUTO, Placement::Auto),
+            (SC_PLACEMENT_IGNORE, Placement::Ignore),
+            (SC_PLACEMENT_TRUST, Placement::Trust),
+        ] {
+            assert_eq!(Placement::ALL[value as usize], placement);
+            assert_eq!(option.choices[value as usize], placement.name());
+        }
+    }
+
+    #[test]
+    fn header_landmark_limit_is_the_librarys() {
+        assert_eq!(SC_MAX_LANDMARKS, crate::maps::landmarks::MAX_LANDMARKS);
+    }
 }

@@ -1,14 +1,15 @@
 //! Point-to-point maps between two shapes: `sc_pointwise_map` and the result's accessors.
 
-use std::ffi::{c_char, c_void, CString};
+use std::ffi::{c_char, c_void};
 
 use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
     Failure, FfiResult, ScStatus,
 };
-use super::correspondence::{warning_ptr, warning_text, ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
+use super::correspondence::{ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
+use super::verdict::{self, VerdictText};
 use super::{CallbackProgress, ScProgressCallback};
 use crate::pipeline::PointwiseCorrespondence;
 
@@ -17,9 +18,16 @@ use crate::pipeline::PointwiseCorrespondence;
 /// several threads at once. Free it with `sc_pointwise_free`.
 pub struct ScPointwise {
     pub(crate) result: PointwiseCorrespondence,
-    /// The verdict's warning, made once with the handle: what `sc_pointwise_warning` points
-    /// into.
-    warning: Option<CString>,
+    /// The verdict's warning and hypothesis names, made once with the handle: what
+    /// `sc_pointwise_warning` and `sc_pointwise_hypothesis` point into.
+    text: VerdictText,
+}
+
+impl ScPointwise {
+    pub(crate) fn new(result: PointwiseCorrespondence) -> Self {
+        let text = VerdictText::new(result.verdict());
+        ScPointwise { result, text }
+    }
 }
 
 /// Option `p2p_regions`: no region constraint (then `p2p_wks` must be true).
@@ -78,8 +86,7 @@ pub unsafe extern "C" fn sc_pointwise_map(
             options.pointwise(),
             &mut progress,
         )?;
-        let warning = warning_text(result.verdict());
-        give_handle(out_pointwise, ScPointwise { result, warning })
+        give_handle(out_pointwise, ScPointwise::new(result))
     })
 }
 
@@ -263,7 +270,110 @@ pub unsafe extern "C" fn sc_pointwise_confidence(pointwise: *const ScPointwise) 
 #[no_mangle]
 pub unsafe extern "C" fn sc_pointwise_warning(pointwise: *const ScPointwise) -> *const c_char {
     boundary_value(std::ptr::null(), || {
-        Ok(warning_ptr(&handle(pointwise, "pointwise")?.warning))
+        Ok(handle(pointwise, "pointwise")?.text.warning())
+    })
+}
+
+/// The name of a verified hypothesis, for the verdict behind `sc_pointwise_confidence` (as
+/// `sc_correspondence_hypothesis`: `which` is `SC_ANSWER_CHOSEN` or `SC_ANSWER_RUNNER_UP`;
+/// NULL when there is none). The string belongs to `pointwise`: valid until it is freed.
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_hypothesis(
+    pointwise: *const ScPointwise,
+    which: u32,
+) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        handle(pointwise, "pointwise")?.text.name(which)
+    })
+}
+
+/// The cost of hypothesis `which` (as `sc_correspondence_hypothesis_cost`; NaN when there is
+/// none).
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_hypothesis_cost(
+    pointwise: *const ScPointwise,
+    which: u32,
+) -> f64 {
+    boundary_value(f64::NAN, || {
+        let p = handle(pointwise, "pointwise")?;
+        verdict::hypothesis_value(p.result.verdict(), which, |h| h.energy.cost())
+    })
+}
+
+/// The rigid turn, in degrees, that the map of hypothesis `which` implies between B as
+/// placed and A (as `sc_correspondence_turn_degrees`; NaN when there is none).
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_turn_degrees(
+    pointwise: *const ScPointwise,
+    which: u32,
+) -> f64 {
+    boundary_value(f64::NAN, || {
+        let p = handle(pointwise, "pointwise")?;
+        verdict::hypothesis_value(p.result.verdict(), which, |h| h.turn_degrees)
+    })
+}
+
+/// What settled the choice among the hypotheses (as `sc_correspondence_decided_by`; static,
+/// NULL when nothing was verified).
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_decided_by(pointwise: *const ScPointwise) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        Ok(verdict::decided_by(
+            handle(pointwise, "pointwise")?.result.verdict(),
+        ))
+    })
+}
+
+/// True when the shapes' placement settled the choice (`sc_pointwise_decided_by` is
+/// `"placement"`); false otherwise, and for NULL.
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_placement_used(pointwise: *const ScPointwise) -> bool {
+    boundary_value(false, || {
+        Ok(verdict::placement_used(
+            handle(pointwise, "pointwise")?.result.verdict(),
+        ))
+    })
+}
+
+/// The other answer: a new pointwise map holding the runner-up hypothesis's vertex map (at
+/// full resolution), functional map and one-to-one regions, with its verdict (decided by
+/// `"other answer"`). Nothing is recomputed: the hypotheses were verified with the first
+/// answer. Every accessor, `sc_surface_map_new` (with the same two shapes) included, works on
+/// it; the caller frees it with `sc_pointwise_free`, independently of `pointwise`.
+///
+/// Errors: `SC_STATUS_INVALID_ARGUMENT` when there is no other answer (nothing was verified,
+/// or no other hypothesis gives a different map; `sc_last_error` says which).
+///
+/// # Safety
+/// `pointwise` must be live; `out_pointwise` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_other_answer(
+    pointwise: *const ScPointwise,
+    out_pointwise: *mut *mut ScPointwise,
+) -> ScStatus {
+    boundary(|| {
+        check_out(out_pointwise, "out_pointwise")?;
+        let p = handle(pointwise, "pointwise")?;
+        let other = p
+            .result
+            .other_answer()
+            .ok_or_else(|| verdict::no_other_answer(p.result.verdict()))?;
+        give_handle(out_pointwise, ScPointwise::new(other))
     })
 }
 

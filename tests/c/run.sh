@@ -54,7 +54,8 @@ fi
 # they run whole plain and under ASan+UBSan+LSan above (a sixth of valgrind's time).
 ownership=(version status_text options option_extremes shape_errors repairs match_errors
     resource_limits life_cycle cancel_huge_restarts symmetry pointwise_options pointwise_errors
-    pointwise_permuted_copy pointwise_cancellation transfer handles_in_use surface_map_shapes batch)
+    pointwise_permuted_copy pointwise_cancellation transfer handles_in_use surface_map_shapes batch
+    landmarks_and_other_answer landmark_errors)
 # --fair-sched: valgrind runs one thread at a time; fair turns keep the caller's thread,
 # which delivers a cancel, from waiting behind the workers. Since it runs one thread at a
 # time, the threads test (half the time) runs in a second valgrind beside the others: one

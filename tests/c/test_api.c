@@ -543,7 +543,7 @@ static void test_point_cloud(void) {
 static void test_unverified_has_no_confidence(void) {
     sc_shape *a = figure("star4", 0), *b = figure("star4", 2);
     sc_params *params = NULL;
-    sc_correspondence *c = NULL;
+    sc_correspondence *c = NULL, *other = NULL;
     bool verify = false;
     if (a == NULL || b == NULL)
         return;
@@ -556,6 +556,13 @@ static void test_unverified_has_no_confidence(void) {
         CHECK(isnan(sc_correspondence_confidence(c)), "confidence %g without verification",
               sc_correspondence_confidence(c));
         CHECK(sc_correspondence_warning(c) == NULL, "no warning without verification");
+        CHECK(sc_correspondence_hypothesis(c, SC_ANSWER_CHOSEN) == NULL, "no hypothesis");
+        CHECK(sc_correspondence_decided_by(c) == NULL, "nothing decided");
+        CHECK(isnan(sc_correspondence_turn_degrees(c, SC_ANSWER_CHOSEN)), "no turn");
+        CHECK_STATUS(sc_correspondence_other_answer(c, &other), SC_STATUS_INVALID_ARGUMENT);
+        CHECK(strstr(sc_last_error(), "no other answer") != NULL, "message: %s",
+              sc_last_error());
+        CHECK(other == NULL, "nothing written on failure");
     }
     sc_correspondence_free(c);
     sc_params_free(params);
@@ -740,6 +747,11 @@ static void test_pointwise_options(void) {
         } else if (strcmp(name, "p2p_regions") == 0) {
             CHECK(strcmp(sc_option_choice(i, SC_P2P_REGIONS_SYMMETRIC), "symmetric") == 0,
                   "symmetric");
+        } else if (strcmp(name, "placement") == 0) {
+            CHECK(strcmp(sc_option_choice(i, SC_PLACEMENT_AUTO), "auto") == 0, "auto");
+            CHECK(strcmp(sc_option_choice(i, SC_PLACEMENT_IGNORE), "ignore") == 0, "ignore");
+            CHECK(strcmp(sc_option_choice(i, SC_PLACEMENT_TRUST), "trust") == 0, "trust");
+            CHECK(sc_option_choice(i, 3) == NULL, "past the last choice");
         } else {
             CHECK(sc_option_choice(i, 0) == NULL, "%s is not a choice", name);
         }
@@ -1520,6 +1532,212 @@ static void test_batch(void) {
 }
 
 /* Every test, in the order a plain run takes them. */
+/* -------------------------------------------------- placement, landmarks, other answer */
+
+/* Landmarks given with the parameters map exactly to their partners; the verdict names the
+ * chosen hypothesis, the runner-up, what decided and the turns; the other answer is the
+ * runner-up's map, different from the first, and a surface map accepts it. The figures of
+ * one kind and size share their vertex order, so (v, v) pairs are true landmarks. */
+static void test_landmarks_and_other_answer(void) {
+    sc_shape *a = figure("humanoid", 0), *b = figure("humanoid", 3);
+    sc_params *params = pointwise_params();
+    sc_pointwise *p = NULL, *other = NULL, *back = NULL;
+    sc_correspondence *regions = NULL, *other_regions = NULL;
+    sc_surface_map *m = NULL;
+    size_t nb = sc_shape_n_vertices(b), i, differ = 0;
+    uint32_t pairs[4], got[4] = {0, 0, 0, 0};
+    uint32_t *map = malloc(nb * sizeof *map), *other_map = malloc(nb * sizeof *other_map);
+    const char *chosen, *runner_up, *decided;
+    int64_t placement = -1;
+    pairs[0] = pairs[1] = (uint32_t)(nb / 7);
+    pairs[2] = pairs[3] = (uint32_t)(3 * nb / 5);
+    CHECK_STATUS(sc_params_set_int(params, "placement", SC_PLACEMENT_IGNORE), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_get_int(params, "placement", &placement), SC_STATUS_OK);
+    CHECK(placement == SC_PLACEMENT_IGNORE, "placement %lld", (long long)placement);
+    CHECK_STATUS(sc_params_set_int(params, "placement", 3), SC_STATUS_INVALID_PARAMETER);
+    CHECK_STATUS(sc_params_set_landmarks(params, pairs, 2), SC_STATUS_OK);
+    CHECK(sc_params_n_landmarks(params) == 2, "%zu landmarks", sc_params_n_landmarks(params));
+    CHECK_STATUS(sc_params_landmarks(params, got, 3), SC_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(sc_params_landmarks(params, got, 4), SC_STATUS_OK);
+    CHECK(memcmp(got, pairs, sizeof pairs) == 0, "landmarks read back %u %u %u %u", got[0],
+          got[1], got[2], got[3]);
+
+    CHECK_STATUS(sc_pointwise_map(a, b, params, NULL, NULL, &p), SC_STATUS_OK);
+    if (p == NULL || map == NULL || other_map == NULL)
+        goto done;
+    CHECK_STATUS(sc_pointwise_map_b_to_a(p, map, nb), SC_STATUS_OK);
+    CHECK(map[pairs[1]] == pairs[0] && map[pairs[3]] == pairs[2],
+          "landmarks map to their partners: %u -> %u, %u -> %u", pairs[1], map[pairs[1]],
+          pairs[3], map[pairs[3]]);
+
+    chosen = sc_pointwise_hypothesis(p, SC_ANSWER_CHOSEN);
+    runner_up = sc_pointwise_hypothesis(p, SC_ANSWER_RUNNER_UP);
+    decided = sc_pointwise_decided_by(p);
+    CHECK(chosen != NULL && decided != NULL, "a verified answer names its hypothesis");
+    CHECK(runner_up != NULL, "a humanoid pair has a runner-up (its mirror image at least)");
+    if (chosen == NULL || runner_up == NULL || decided == NULL)
+        goto done;
+    CHECK(strcmp(decided, "cost") == 0 || strcmp(decided, "close call") == 0 ||
+              strcmp(decided, "landmarks") == 0,
+          "placement ignored: decided by %s", decided);
+    CHECK(!sc_pointwise_placement_used(p), "placement ignored, yet used");
+    CHECK(sc_pointwise_hypothesis(p, SC_ANSWER_CHOSEN) == chosen, "the handle owns the name");
+    CHECK(strcmp(chosen, runner_up) != 0, "chosen %s, runner-up %s", chosen, runner_up);
+    for (i = 0; i < 2; i++) {
+        double cost = sc_pointwise_hypothesis_cost(p, (uint32_t)i);
+        double turn = sc_pointwise_turn_degrees(p, (uint32_t)i);
+        CHECK(isfinite(cost) && cost >= 0.0, "cost %g of hypothesis %zu", cost, i);
+        CHECK(turn >= 0.0 && turn <= 180.0, "turn %g of hypothesis %zu", turn, i);
+    }
+    CHECK(sc_pointwise_hypothesis(p, 2) == NULL, "which 2 is no hypothesis");
+    CHECK(strstr(sc_last_error(), "SC_ANSWER_RUNNER_UP") != NULL, "message: %s",
+          sc_last_error());
+    CHECK(isnan(sc_pointwise_hypothesis_cost(p, 2)) && isnan(sc_pointwise_turn_degrees(p, 2)),
+          "NaN for which 2");
+
+    /* The other answer: the runner-up's map, decided by "other answer". */
+    CHECK_STATUS(sc_pointwise_other_answer(p, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_pointwise_other_answer(p, &other), SC_STATUS_OK);
+    if (other == NULL)
+        goto done;
+    CHECK_STATUS(sc_pointwise_map_b_to_a(other, other_map, nb), SC_STATUS_OK);
+    for (i = 0; i < nb; i++)
+        differ += other_map[i] != map[i];
+    CHECK(differ > nb / 10, "the other answer moves %zu of %zu vertices", differ, nb);
+    CHECK(other_map[pairs[1]] == pairs[0] && other_map[pairs[3]] == pairs[2],
+          "the other answer keeps the landmarks pinned: %u, %u", other_map[pairs[1]],
+          other_map[pairs[3]]);
+    CHECK(strcmp(sc_pointwise_hypothesis(other, SC_ANSWER_CHOSEN), runner_up) == 0,
+          "the other answer is the runner-up %s, got %s", runner_up,
+          sc_pointwise_hypothesis(other, SC_ANSWER_CHOSEN));
+    CHECK(strcmp(sc_pointwise_decided_by(other), "other answer") == 0, "decided by %s",
+          sc_pointwise_decided_by(other));
+    CHECK(sc_pointwise_hypothesis_cost(other, SC_ANSWER_CHOSEN) ==
+              sc_pointwise_hypothesis_cost(p, SC_ANSWER_RUNNER_UP),
+          "the same cost, nothing recomputed");
+    CHECK(sc_pointwise_n_vertices(other, SC_SIDE_A) == sc_pointwise_n_vertices(p, SC_SIDE_A),
+          "the same shapes");
+    CHECK_STATUS(sc_surface_map_new(a, b, other, NULL, NULL, &m), SC_STATUS_OK);
+    CHECK(sc_surface_map_n_vertices(m, SC_SIDE_B) == nb, "surface map of the other answer");
+    /* Its own other answer exists too (the first one, usually), a handle of its own. */
+    CHECK_STATUS(sc_pointwise_other_answer(other, &back), SC_STATUS_OK);
+
+    /* The region results carry the same verdict and give their own other answer. */
+    CHECK_STATUS(sc_pointwise_regions(p, &regions), SC_STATUS_OK);
+    if (regions != NULL) {
+        CHECK(strcmp(sc_correspondence_hypothesis(regions, SC_ANSWER_CHOSEN), chosen) == 0,
+              "the regions' verdict is the map's");
+        CHECK(strcmp(sc_correspondence_decided_by(regions), decided) == 0, "decided by %s",
+              sc_correspondence_decided_by(regions));
+        CHECK(sc_correspondence_turn_degrees(regions, SC_ANSWER_RUNNER_UP) ==
+                  sc_pointwise_turn_degrees(p, SC_ANSWER_RUNNER_UP),
+              "the same runner-up");
+        CHECK(!sc_correspondence_placement_used(regions), "placement ignored");
+        CHECK_STATUS(sc_correspondence_other_answer(regions, &other_regions), SC_STATUS_OK);
+        if (other_regions != NULL)
+            CHECK(strcmp(sc_correspondence_decided_by(other_regions), "other answer") == 0,
+                  "decided by %s", sc_correspondence_decided_by(other_regions));
+    }
+done:
+    sc_correspondence_free(other_regions);
+    sc_correspondence_free(regions);
+    sc_surface_map_free(m);
+    sc_pointwise_free(back);
+    sc_pointwise_free(other);
+    sc_pointwise_free(p);
+    sc_params_free(params);
+    free(map);
+    free(other_map);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
+/* Bad landmarks: refused by the setter (NULL, too many) or when the job starts (out of
+ * range, left out by the repairs, one vertex with two partners), with the pair named and
+ * nothing written; no result accessor fails on a result without a verdict. */
+static void test_landmark_errors(void) {
+    sc_shape *a = figure("star5", 0), *b = figure("star5", 2), *loose = NULL;
+    sc_params *params = NULL;
+    sc_pointwise *p = NULL, *sentinel = (sc_pointwise *)&p;
+    sc_correspondence *c = NULL, *csentinel = (sc_correspondence *)&c;
+    size_t n = sc_shape_n_vertices(b), nt = sc_shape_n_triangles(b);
+    uint32_t pairs[2 * (SC_MAX_LANDMARKS + 1)], *faces = malloc(3 * nt * sizeof *faces);
+    double *vertices = malloc(3 * (n + 1) * sizeof *vertices);
+    size_t i;
+    for (i = 0; i < 2 * (SC_MAX_LANDMARKS + 1); i++)
+        pairs[i] = (uint32_t)(i / 2);
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_landmarks(NULL, pairs, 1), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_set_landmarks(params, NULL, 2), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_params_set_landmarks(params, pairs, SC_MAX_LANDMARKS + 1),
+                 SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "at most 100") != NULL, "message: %s", sc_last_error());
+    CHECK(sc_params_n_landmarks(params) == 0, "nothing set by a failed call");
+    CHECK_STATUS(sc_params_set_landmarks(params, pairs, SC_MAX_LANDMARKS), SC_STATUS_OK);
+    CHECK(sc_params_n_landmarks(params) == SC_MAX_LANDMARKS, "the limit itself is accepted");
+    CHECK_STATUS(sc_params_set_landmarks(params, NULL, 0), SC_STATUS_OK);
+    CHECK(sc_params_n_landmarks(params) == 0, "0 pairs clear them");
+    CHECK(sc_params_n_landmarks(NULL) == 0, "none for NULL");
+    CHECK_STATUS(sc_params_landmarks(NULL, pairs, 2), SC_STATUS_NULL_ARGUMENT);
+
+    /* Out of range on B: pair 2 named, refused before any work, nothing written. */
+    pairs[0] = 1; pairs[1] = 1; pairs[2] = 2; pairs[3] = (uint32_t)n + 5;
+    CHECK_STATUS(sc_params_set_landmarks(params, pairs, 2), SC_STATUS_OK);
+    p = sentinel;
+    CHECK_STATUS(sc_pointwise_map(a, b, params, NULL, NULL, &p), SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "pair 2") != NULL && strstr(sc_last_error(), "landmarks"),
+          "message: %s", sc_last_error());
+    CHECK(p == sentinel, "nothing written on failure");
+    c = csentinel;
+    CHECK_STATUS(sc_match(a, b, params, NULL, NULL, &c), SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "pair 2") != NULL, "message: %s", sc_last_error());
+    CHECK(c == csentinel, "nothing written on failure");
+    /* One vertex of A given two partners. */
+    pairs[2] = 1; pairs[3] = 7;
+    CHECK_STATUS(sc_params_set_landmarks(params, pairs, 2), SC_STATUS_OK);
+    CHECK_STATUS(sc_pointwise_map(a, b, params, NULL, NULL, &p), SC_STATUS_INVALID_PARAMETER);
+    CHECK(strstr(sc_last_error(), "contradict") != NULL, "message: %s", sc_last_error());
+    /* A vertex no face uses (left out of the computation). */
+    if (faces != NULL && vertices != NULL) {
+        CHECK_STATUS(sc_shape_vertices(b, vertices, 3 * n), SC_STATUS_OK);
+        CHECK_STATUS(sc_shape_triangles(b, faces, 3 * nt), SC_STATUS_OK);
+        vertices[3 * n] = vertices[3 * n + 1] = vertices[3 * n + 2] = 0.0;
+        CHECK_STATUS(sc_shape_new_mesh(vertices, n + 1, faces, nt, &loose), SC_STATUS_OK);
+        pairs[0] = 3; pairs[1] = (uint32_t)n;
+        CHECK_STATUS(sc_params_set_landmarks(params, pairs, 1), SC_STATUS_OK);
+        CHECK_STATUS(sc_pointwise_map(a, loose, params, NULL, NULL, &p),
+                     SC_STATUS_INVALID_PARAMETER);
+        CHECK(strstr(sc_last_error(), "not used by the computation") != NULL, "message: %s",
+              sc_last_error());
+    }
+    CHECK(p == sentinel, "nothing written on failure");
+
+    /* NULL results: no name, no cost, no decision, no other answer. */
+    CHECK(sc_pointwise_hypothesis(NULL, SC_ANSWER_CHOSEN) == NULL, "NULL pointwise");
+    CHECK(sc_correspondence_hypothesis(NULL, SC_ANSWER_CHOSEN) == NULL, "NULL correspondence");
+    CHECK(sc_pointwise_decided_by(NULL) == NULL && sc_correspondence_decided_by(NULL) == NULL,
+          "no decision for NULL");
+    CHECK(!sc_pointwise_placement_used(NULL) && !sc_correspondence_placement_used(NULL),
+          "no placement for NULL");
+    CHECK(isnan(sc_pointwise_turn_degrees(NULL, 0)) && isnan(sc_correspondence_turn_degrees(NULL, 0)),
+          "no turn for NULL");
+    CHECK(isnan(sc_pointwise_hypothesis_cost(NULL, 0)) &&
+              isnan(sc_correspondence_hypothesis_cost(NULL, 0)),
+          "no cost for NULL");
+    p = sentinel;
+    CHECK_STATUS(sc_pointwise_other_answer(NULL, &p), SC_STATUS_NULL_ARGUMENT);
+    CHECK(p == sentinel, "nothing written on failure");
+    c = csentinel;
+    CHECK_STATUS(sc_correspondence_other_answer(NULL, &c), SC_STATUS_NULL_ARGUMENT);
+    CHECK(c == csentinel, "nothing written on failure");
+    sc_shape_free(loose);
+    sc_params_free(params);
+    free(faces);
+    free(vertices);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
 static const struct {
     const char *name;
     void (*run)(void);
@@ -1547,6 +1765,8 @@ static const struct {
     {"surface_map_shapes", test_surface_map_shapes},
     {"no_match_is_an_error", test_no_match_is_an_error},
     {"batch", test_batch},
+    {"landmarks_and_other_answer", test_landmarks_and_other_answer},
+    {"landmark_errors", test_landmark_errors},
     {"concurrency", test_concurrency},
 };
 

@@ -11,6 +11,9 @@ A ctypes binding over the C API of libshapecorr (``include/shapecorr.h``)::
     result.colors("a")          # (n_vertices, 4) RGBA bytes, matched regions share a colour
     result.confidence           # in [0, 1], or None when the answer was not verified
     result.warning              # a sentence when the answer is doubtful, else None
+    result.hypothesis, result.decided_by, result.runner_up   # what was chosen, and why
+    other = result.other_answer()   # the runner-up's answer (nothing recomputed), or None
+    shapecorr.match(a, b, landmarks=[(12, 40), (300, 311)], placement="ignore")
     pointwise = shapecorr.pointwise_map(a, b)
     pointwise.map_b_to_a        # vertex of A for every vertex of B (numpy uint32)
     shapecorr.Shape.from_trimesh(mesh)   # also from_open3d, from_mesh (vertices, faces)
@@ -78,6 +81,9 @@ __all__ = [
     "BoolValue",
     "RegionsChoice",
     "RefinementChoice",
+    "PlacementChoice",
+    "Hypothesis",
+    "Landmarks",
     "ProgressCallback",
     "RepairSpec",
     "Side",
@@ -111,6 +117,11 @@ BoolValue = Union[bool, "np.bool_"]
 RegionsChoice = Union[IntValue, Literal["none", "one-to-one", "symmetric"]]
 #: ``p2p_refinement``: by name, or by value (0, 1, 2).
 RefinementChoice = Union[IntValue, Literal["none", "zoomout", "icp"]]
+#: ``placement``: by name, or by value (0, 1, 2); see docs/placement.md.
+PlacementChoice = Union[IntValue, Literal["auto", "ignore", "trust"]]
+#: ``landmarks``: pairs ``(vertex of A, vertex of B)``, a sequence of pairs of non-negative
+#: integers or an (n, 2) integer array.
+Landmarks = Union[Iterable[Iterable[IntValue]], "NDArray[np.integer[Any]]"]
 
 
 class RegionOptions(TypedDict, total=False):
@@ -144,6 +155,7 @@ class RegionOptions(TypedDict, total=False):
     max_vertices: IntValue
     memory_limit_mib: IntValue
     time_limit_s: FloatValue
+    placement: PlacementChoice
 
 
 class PointwiseOptions(RegionOptions, total=False):
@@ -515,8 +527,11 @@ def _coordinates(array, f32_function, f64_function):
 class _Params(_Handle):
     _free = lib.sc_params_free
 
-    def __init__(self, values):
+    def __init__(self, values, landmarks=None):
         super().__init__(_new_handle(lib.sc_params_new))
+        if landmarks is not None:
+            pairs = _landmark_array(landmarks)
+            _check(lib.sc_params_set_landmarks(self, _ptr(pairs, ctypes.c_uint32), len(pairs)))
         table = _option_table()
         for name, value in _choice_values(values).items():
             if name not in table:
@@ -541,6 +556,51 @@ class _Params(_Handle):
                 raise _OptionTypeError(2, f"option `{name}` takes True or False, got {value!r}")
             converted = {"int": int, "float": float, "bool": bool}[kind](value)
             _check(setter(self, name.encode(), converted))
+
+
+def _landmark_array(landmarks):
+    """``landmarks`` (pairs ``(vertex of A, vertex of B)``: a sequence of pairs of integers
+    or an (n, 2) integer array) as a contiguous (n, 2) uint32 array. A bool, a float or a
+    string where an index goes is refused (:class:`ShapecorrError` ``INVALID_ARGUMENT`` that
+    is also a TypeError), as is anything but pairs; a negative index or one past uint32
+    raises :class:`ShapecorrError` ``INVALID_PARAMETER`` naming the pair. The library checks
+    the rest against the shapes when the job starts."""
+    if isinstance(landmarks, np.ndarray):
+        if landmarks.size and landmarks.dtype.kind not in "iu":
+            raise _OptionTypeError(
+                2, f"`landmarks` must hold integer vertex indices, got an array of {landmarks.dtype}"
+            )
+        if landmarks.size and (landmarks.ndim != 2 or landmarks.shape[1] != 2):
+            raise _OptionTypeError(2, f"`landmarks` must have shape (n, 2), got {landmarks.shape}")
+        rows = [tuple(int(v) for v in row) for row in landmarks.reshape(-1, 2)]
+    else:
+        if isinstance(landmarks, (str, bytes)) or not hasattr(landmarks, "__iter__"):
+            raise _OptionTypeError(
+                2, f"`landmarks` must be pairs (vertex of A, vertex of B), got {landmarks!r}"
+            )
+        rows = []
+        for i, pair in enumerate(landmarks, start=1):
+            if isinstance(pair, (str, bytes)) or not hasattr(pair, "__iter__"):
+                raise _OptionTypeError(2, f"`landmarks`: pair {i} is not a pair of vertices: {pair!r}")
+            pair = tuple(pair)
+            if len(pair) != 2:
+                raise _OptionTypeError(
+                    2, f"`landmarks`: pair {i} has {len(pair)} values, a pair has 2: {pair!r}"
+                )
+            for v in pair:
+                if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+                    raise _OptionTypeError(
+                        2, f"`landmarks`: pair {i} {pair!r}: a vertex index must be an integer, "
+                        f"got {type(v).__name__} {v!r}"
+                    )
+            rows.append((int(pair[0]), int(pair[1])))
+    for i, (va, vb) in enumerate(rows, start=1):
+        if not (0 <= va < 2**32 and 0 <= vb < 2**32):
+            raise ShapecorrError(
+                15, f"invalid parameter `landmarks`: pair {i} ({va}, {vb}): a vertex index "
+                "must be a non-negative integer (indices start at 0)"
+            )
+    return np.array(rows, dtype=np.uint32).reshape(-1, 2)
 
 
 class _OptionTypeError(ShapecorrError, TypeError):
@@ -726,8 +786,89 @@ class RegionGraph(TypedDict):
     edges: NDArray[np.uint32]
 
 
-class Correspondence(_Handle):
+class Hypothesis(NamedTuple):
+    """A verified hypothesis of a result (:attr:`Correspondence.runner_up`,
+    :attr:`Correspondence.chosen`): its name, cost and the turn its map implies."""
+
+    #: ``"answer"``, ``"mirror"``, ``"symmetric"``, ``"alternative N"`` or ``"placement"``.
+    hypothesis: str
+    #: The cost the hypotheses are ranked by (lower is better).
+    cost: float
+    #: The rigid turn, in degrees (0 to 180), its map implies between B as placed and A.
+    turn_degrees: float
+
+
+class _Verdict:
+    """What a result says about its choice among the verified hypotheses (docs/placement.md),
+    read through the C functions named ``{_prefix}_hypothesis`` etc."""
+
+    _prefix = ""
+
+    def _c(self, name):
+        return getattr(lib, f"{self._prefix}_{name}")
+
+    def _hypothesis(self, which):
+        name = self._c("hypothesis")(self, which)
+        if name is None:
+            return None
+        return Hypothesis(
+            name.decode("utf-8", "replace"),
+            float(self._c("hypothesis_cost")(self, which)),
+            float(self._c("turn_degrees")(self, which)),
+        )
+
+    @property
+    def chosen(self) -> Hypothesis | None:
+        """The chosen hypothesis (name, cost, turn), or None when the answer was not verified
+        (:attr:`confidence` is None)."""
+        return self._hypothesis(_lib.ANSWER_CHOSEN)
+
+    @property
+    def hypothesis(self) -> str | None:
+        """The chosen hypothesis's name (``"answer"``, ``"mirror"``, ``"symmetric"``,
+        ``"alternative N"``, ``"placement"``), or None when the answer was not verified."""
+        chosen = self.chosen
+        return None if chosen is None else chosen.hypothesis
+
+    @property
+    def turn_degrees(self) -> float | None:
+        """The rigid turn, in degrees (0 to 180), that the chosen map implies between B as
+        placed and A (near 0: the map agrees with where the shapes stand; near 180: a
+        half-turn), or None when the answer was not verified."""
+        chosen = self.chosen
+        return None if chosen is None else chosen.turn_degrees
+
+    @property
+    def decided_by(self) -> str | None:
+        """What settled the choice: ``"cost"``, ``"close call"``, ``"placement"`` (where the
+        shapes stand), ``"landmarks"`` or ``"other answer"`` (a result of
+        :meth:`other_answer`); None when the answer was not verified."""
+        text = self._c("decided_by")(self)
+        return None if text is None else text.decode()
+
+    @property
+    def placement_used(self) -> bool:
+        """True when where the shapes stand settled the choice (``decided_by ==
+        "placement"``; option ``placement``)."""
+        return bool(self._c("placement_used")(self))
+
+    @property
+    def runner_up(self) -> Hypothesis | None:
+        """The runner-up (name, cost, turn): the cheapest other hypothesis whose map differs
+        from the chosen one, the answer :meth:`other_answer` gives; None when there is none."""
+        return self._hypothesis(_lib.ANSWER_RUNNER_UP)
+
+    def _other_handle(self):
+        """The C handle of the other answer, or None when there is no runner-up."""
+        if self._c("hypothesis")(self, _lib.ANSWER_RUNNER_UP) is None:
+            return None
+        return _new_handle(self._c("other_answer"), self)
+
+
+class Correspondence(_Verdict, _Handle):
     """The result of :func:`match` (immutable; safe to share between threads)."""
+
+    _prefix = "sc_correspondence"
 
     _free = lib.sc_correspondence_free
 
@@ -813,6 +954,13 @@ class Correspondence(_Handle):
         """True when the answer has a confidence below ``CONFIDENCE_DOUBTFUL_BELOW``."""
         return self.warning is not None
 
+    def other_answer(self) -> Correspondence | None:
+        """The other answer: a new :class:`Correspondence` whose one-to-one matches are the
+        :attr:`runner_up`'s, with its verdict (``decided_by == "other answer"``); nothing is
+        recomputed. None when there is no runner-up."""
+        pointer = self._other_handle()
+        return None if pointer is None else Correspondence(pointer)
+
     @property
     def timings(self) -> dict[str, float]:
         """Seconds per stage, and ``total``."""
@@ -859,7 +1007,12 @@ class Symmetry(_Handle):
 
 
 def match(
-    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: Unpack[RegionOptions]
+    a: Shape,
+    b: Shape,
+    progress: ProgressCallback | None = None,
+    *,
+    landmarks: Landmarks | None = None,
+    **options: Unpack[RegionOptions],
 ) -> Correspondence:
     """Region correspondence between shapes ``a`` and ``b``. ``options`` are named options
     (``k_min=5, k_max=10, one_to_one=True, ...``; :class:`RegionOptions`, see
@@ -867,9 +1020,17 @@ def match(
     least every 0.2 s and cancels by returning a falsy value other than None (``False``,
     ``0``, ``np.False_``): :class:`ShapecorrError` with status ``CANCELLED``. Ctrl-C cancels
     and raises KeyboardInterrupt. A job over ``memory_limit_mib``, ``time_limit_s`` or
-    ``max_vertices`` raises :class:`ResourceLimitError`."""
+    ``max_vertices`` raises :class:`ResourceLimitError`.
+
+    ``landmarks``: pairs ``(vertex of A, vertex of B)`` known to correspond (0-based input
+    indices; a sequence of pairs or an (n, 2) integer array; at most 100): the answer is
+    chosen to agree with them (two pairs on one side of a body settle every symmetric
+    choice). ``placement="auto"`` (the default), ``"ignore"`` or ``"trust"``: how where the
+    shapes stand is used (docs/placement.md). A bad landmark (past the end of its shape,
+    left out by the repairs, one vertex with two partners) raises :class:`ShapecorrError`
+    naming the pair."""
     _expect(a, Shape, "a"), _expect(b, Shape, "b")
-    params = _Params(options)
+    params = _Params(options, landmarks)
     return Correspondence(_Progress(progress).run(lib.sc_match, a, b, params))
 
 
@@ -882,8 +1043,12 @@ def detect_symmetry(
     return Symmetry(_Progress(progress).run(lib.sc_symmetry_detect, shape, params))
 
 
-class PointwiseMap(_Handle):
-    """The result of :func:`pointwise_map` (immutable; safe to share between threads)."""
+class PointwiseMap(_Verdict, _Handle):
+    """The result of :func:`pointwise_map` (immutable; safe to share between threads). The
+    verdict's properties (:attr:`hypothesis`, :attr:`decided_by`, :attr:`runner_up`, ...)
+    read the choice behind :attr:`confidence`."""
+
+    _prefix = "sc_pointwise"
 
     _free = lib.sc_pointwise_free
 
@@ -945,12 +1110,25 @@ class PointwiseMap(_Handle):
             out[stage] = value.value
         return out
 
+    def other_answer(self) -> PointwiseMap | None:
+        """The other answer: a new :class:`PointwiseMap` holding the :attr:`runner_up`'s
+        vertex map (every vertex of B), functional map and one-to-one regions, with its
+        verdict (``decided_by == "other answer"``); nothing is recomputed. It works with
+        :func:`surface_map` like this one. None when there is no runner-up."""
+        pointer = self._other_handle()
+        return None if pointer is None else PointwiseMap(pointer)
+
     def __repr__(self) -> str:
         return f"<shapecorr.PointwiseMap {self.n_vertices_b} vertices of B -> {self.n_vertices_a} of A>"
 
 
 def pointwise_map(
-    a: Shape, b: Shape, progress: ProgressCallback | None = None, **options: Unpack[PointwiseOptions]
+    a: Shape,
+    b: Shape,
+    progress: ProgressCallback | None = None,
+    *,
+    landmarks: Landmarks | None = None,
+    **options: Unpack[PointwiseOptions],
 ) -> PointwiseMap:
     """Point-to-point map from shape ``b`` to shape ``a``: the region correspondence of
     :func:`match`, then a functional map constrained by the matched regions, refined by
@@ -959,9 +1137,10 @@ def pointwise_map(
     ``"symmetric"``, or 0, 1, 2), ``p2p_refinement="zoomout"`` (``"none"``, ``"zoomout"``,
     ``"icp"``, or 0, 1, 2), ``p2p_wks=False``, ...; :class:`PointwiseOptions`, see
     :func:`options`). ``progress`` as for :func:`match`; the last stage is
-    ``"pointwise_map"``. Returns a :class:`PointwiseMap`."""
+    ``"pointwise_map"``. ``landmarks`` and ``placement`` as for :func:`match`; every landmark
+    of B maps exactly to its partner. Returns a :class:`PointwiseMap`."""
     _expect(a, Shape, "a"), _expect(b, Shape, "b")
-    params = _Params(options)
+    params = _Params(options, landmarks)
     return PointwiseMap(_Progress(progress).run(lib.sc_pointwise_map, a, b, params))
 
 

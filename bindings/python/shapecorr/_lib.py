@@ -166,6 +166,9 @@ FUNCTIONS = {
     "sc_params_get_int": (status, [handle, c_str, c_i64p]),
     "sc_params_get_double": (status, [handle, c_str, c_f64p]),
     "sc_params_get_bool": (status, [handle, c_str, c_boolp]),
+    "sc_params_set_landmarks": (status, [handle, c_u32p, c_size_t]),
+    "sc_params_n_landmarks": (c_size_t, [handle]),
+    "sc_params_landmarks": (status, [handle, c_u32p, c_size_t]),
     "sc_option_count": (c_size_t, []),
     "sc_option_name": (ctypes.c_char_p, [c_size_t]),
     "sc_option_doc": (ctypes.c_char_p, [c_size_t]),
@@ -191,6 +194,12 @@ FUNCTIONS = {
     "sc_correspondence_seconds": (status, [handle, c_str, c_f64p]),
     "sc_correspondence_confidence": (ctypes.c_double, [handle]),
     "sc_correspondence_warning": (ctypes.c_char_p, [handle]),
+    "sc_correspondence_hypothesis": (ctypes.c_char_p, [handle, u32_arg]),
+    "sc_correspondence_hypothesis_cost": (ctypes.c_double, [handle, u32_arg]),
+    "sc_correspondence_turn_degrees": (ctypes.c_double, [handle, u32_arg]),
+    "sc_correspondence_decided_by": (ctypes.c_char_p, [handle]),
+    "sc_correspondence_placement_used": (ctypes.c_bool, [handle]),
+    "sc_correspondence_other_answer": (status, [handle, handle_out]),
     # symmetry
     "sc_symmetry_detect": (status, [handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_symmetry_free": (None, [handle]),
@@ -212,6 +221,12 @@ FUNCTIONS = {
     "sc_pointwise_seconds": (status, [handle, c_str, c_f64p]),
     "sc_pointwise_confidence": (ctypes.c_double, [handle]),
     "sc_pointwise_warning": (ctypes.c_char_p, [handle]),
+    "sc_pointwise_hypothesis": (ctypes.c_char_p, [handle, u32_arg]),
+    "sc_pointwise_hypothesis_cost": (ctypes.c_double, [handle, u32_arg]),
+    "sc_pointwise_turn_degrees": (ctypes.c_double, [handle, u32_arg]),
+    "sc_pointwise_decided_by": (ctypes.c_char_p, [handle]),
+    "sc_pointwise_placement_used": (ctypes.c_bool, [handle]),
+    "sc_pointwise_other_answer": (status, [handle, handle_out]),
     # transfer
     "sc_surface_map_new": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_surface_map_free": (None, [handle]),
@@ -285,6 +300,11 @@ MATCHES_SYMMETRIC, MATCHES_ONE_TO_ONE = 0, 1
 OPTION_INT, OPTION_DOUBLE, OPTION_BOOL = 0, 1, 2
 P2P_REGIONS_NONE, P2P_REGIONS_ONE_TO_ONE, P2P_REGIONS_SYMMETRIC = 0, 1, 2
 P2P_REFINEMENT_NONE, P2P_REFINEMENT_ZOOMOUT, P2P_REFINEMENT_ICP = 0, 1, 2
+PLACEMENT_AUTO, PLACEMENT_IGNORE, PLACEMENT_TRUST = 0, 1, 2
+#: ``SC_ANSWER_CHOSEN``, ``SC_ANSWER_RUNNER_UP``: which hypothesis a verdict accessor reads.
+ANSWER_CHOSEN, ANSWER_RUNNER_UP = 0, 1
+#: ``SC_MAX_LANDMARKS``: most landmark pairs a job takes.
+MAX_LANDMARKS = 100
 #: Below this confidence an answer is doubtful and has a warning.
 CONFIDENCE_DOUBTFUL_BELOW = 0.45
 STATUS_NAMES = {

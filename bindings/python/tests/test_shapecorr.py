@@ -140,7 +140,11 @@ def test_options_and_defaults():
     assert info["k_min"].choices == ()
     assert info["p2p_refinement"].choices == ("none", "zoomout", "icp")
     assert info["p2p_regions"].choices == ("none", "one-to-one", "symmetric")
-    assert [o.name for o in shapecorr.options() if o.choices] == ["p2p_regions", "p2p_refinement"]
+    assert info["placement"].choices == ("auto", "ignore", "trust")
+    assert info["placement"].default == _lib.PLACEMENT_AUTO
+    assert [o.name for o in shapecorr.options() if o.choices] == [
+        "p2p_regions", "p2p_refinement", "placement"
+    ]
 
 
 def read_back(options, name):
