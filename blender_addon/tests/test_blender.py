@@ -840,6 +840,28 @@ def test_use_other_answer_says_when_there_is_none(addon):
         bpy.ops.shapecorr.other_answer()
 
 
+
+def test_use_other_answer_without_a_runner_up_says_so_and_changes_nothing(addon):
+    """Two quadrupeds (1500 vertices, poses 0 and 1): every answer the library verifies gives
+    the same map (measured), so there is no other answer."""
+    fresh_scene()
+    sc = addon.shapecorr
+    shapes = [sc.Shape.figure("quadruped", pose, 1500) for pose in (0, 1)]
+    a = add_object("A", shapes[0].vertices, shapes[0].triangles)
+    b = add_object("B", shapes[1].vertices, shapes[1].triangles, location=(3.0, 0.0, 0.0))
+    select(a, b)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    expected = sc.match(world_shape(addon, a), world_shape(addon, b))
+    assert expected.confidence is not None and expected.runner_up is None
+    assert expected.other_answer() is None
+    assert "Runner-up: none" in [text for kind, text in draw_panels(addon) if kind == "label"]
+    before = [attribute_arrays(o)[0] for o in (a, b)]
+    with pytest.raises(RuntimeError, match=f"the answer '{expected.hypothesis}' has no runner-up"):
+        bpy.ops.shapecorr.other_answer()
+    assert all(np.array_equal(attribute_arrays(o)[0], f) for o, f in zip((a, b), before))
+    assert bpy.context.scene.shapecorr.answer.operation == "Match Regions"
+
+
 class RecordingLayout:
     """Stands in for a panel's layout (headless Blender draws no panel): records the labels,
     properties and operators drawn, in order."""
