@@ -11,7 +11,8 @@ import threading
 import bpy
 import numpy as np
 
-from . import shapecorr
+from . import memory, shapecorr
+from .landmarks import landmark_pairs
 
 #: Colour attribute (point domain): matched regions share a colour, unmatched ones dark grey.
 COLOR_ATTRIBUTE = "shapecorr_regions"
@@ -48,10 +49,10 @@ def ordered_selection(context):
     return selected
 
 
-def read_shape(obj, depsgraph, as_point_cloud):
-    """The evaluated mesh of ``obj`` (modifiers applied) in world space, as a
-    shapecorr.Shape, in Blender's vertex order. Raises ValueError with a message for the
-    user when the evaluated mesh cannot be written back to the object's own vertices."""
+def read_geometry(obj, depsgraph):
+    """The evaluated mesh of ``obj`` (modifiers applied) in world space, in Blender's vertex
+    order: (vertices (n, 3) float64, triangles (m, 3) int32). Raises ValueError with a message
+    for the user when the evaluated mesh cannot be written back to the object's own vertices."""
     evaluated = obj.evaluated_get(depsgraph)
     mesh = evaluated.to_mesh()
     try:
@@ -70,9 +71,60 @@ def read_shape(obj, depsgraph, as_point_cloud):
         mesh.loop_triangles.foreach_get("vertices", triangles)
     finally:
         evaluated.to_mesh_clear()
+    return world, triangles.reshape(-1, 3)
+
+
+def shape_of(geometry, as_point_cloud):
+    """The shapecorr.Shape of a :func:`read_geometry` result."""
+    world, triangles = geometry
     if as_point_cloud or len(triangles) == 0:
         return shapecorr.Shape.point_cloud(world)
-    return shapecorr.Shape.mesh(world, triangles.reshape(-1, 3))
+    return shapecorr.Shape.mesh(world, triangles)
+
+
+def read_shape(obj, depsgraph, as_point_cloud):
+    """The evaluated mesh of ``obj`` as a shapecorr.Shape (:func:`read_geometry`)."""
+    return shape_of(read_geometry(obj, depsgraph), as_point_cloud)
+
+
+class PairInput:
+    """What a library call on two selected objects reads (main thread): the objects' names,
+    their geometry and shapes, the options and the landmarks, and the fingerprints that say
+    whether a result kept in memory was computed from the same (memory.fingerprint)."""
+
+    def __init__(self, context, as_point_cloud=None):
+        settings = context.scene.shapecorr
+        objects = ordered_selection(context)
+        depsgraph = context.evaluated_depsgraph_get()
+        point_cloud = settings.point_cloud if as_point_cloud is None else as_point_cloud
+        self.names = tuple(o.name for o in objects)
+        self.geometries = [read_geometry(o, depsgraph) for o in objects]
+        self.landmarks = landmark_pairs(context.scene, *objects)
+        self.shapes = [shape_of(g, point_cloud) for g in self.geometries]
+        self.repairs = repair_notes(self.names, self.shapes)
+        self.options = settings.library_options()
+        self.geometry = memory.fingerprint(self.geometries)
+        self.inputs = memory.fingerprint(self.geometries, {**self.options, "point_cloud": point_cloud},
+                                         self.landmarks)
+
+    def arguments(self):
+        """The keyword arguments of shapecorr.match and pointwise_map: the options, and the
+        landmarks when there are any."""
+        if self.landmarks:
+            return {**self.options, "landmarks": self.landmarks}
+        return dict(self.options)
+
+    def entry(self, result):
+        """A memory entry for ``result`` computed from this input."""
+        return memory.Entry(self.names, self.geometry, self.inputs, self.shapes, self.geometries[0][0], result)
+
+    def kept_map(self):
+        """The pointwise map kept in memory for this pair when it was computed from the same
+        input (the answer the scene shows, perhaps the other one): its entry, else None."""
+        kept = memory.entry(self.names)
+        if kept is None or kept.inputs != self.inputs or not isinstance(kept.answers[0], shapecorr.PointwiseMap):
+            return None
+        return kept
 
 
 def repair_notes(names, shapes):
@@ -193,7 +245,9 @@ class _LibraryOperator:
 
         try:
             job.result = work(progress)
-        except shapecorr.ShapecorrError as error:
+        except (shapecorr.ShapecorrError, ValueError, TypeError) as error:
+            # The library's errors, and the binding's refusal of an argument (as the modal
+            # path reports whatever the worker thread raised).
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         finally:
@@ -272,16 +326,14 @@ class SHAPECORR_OT_match_regions(_LibraryOperator, bpy.types.Operator):
     selection_size = 2
 
     def prepare(self, context):
-        settings = context.scene.shapecorr
-        depsgraph = context.evaluated_depsgraph_get()
-        objects = ordered_selection(context)
-        shapes = [read_shape(o, depsgraph, settings.point_cloud) for o in objects]
-        self._names = [o.name for o in objects]
-        self._repairs = repair_notes(self._names, shapes)
-        options = settings.library_options()
+        pair = PairInput(context)
+        self._pair = pair
+        self._names = list(pair.names)
+        self._repairs = pair.repairs
+        arguments = pair.arguments()
 
         def work(progress):
-            return shapecorr.match(shapes[0], shapes[1], progress=progress, **options)
+            return shapecorr.match(pair.shapes[0], pair.shapes[1], progress=progress, **arguments)
 
         return work
 
@@ -289,15 +341,24 @@ class SHAPECORR_OT_match_regions(_LibraryOperator, bpy.types.Operator):
         one_to_one = context.scene.shapecorr.one_to_one
         objects = [bpy.data.objects[name] for name in self._names]
         confidence = result.confidence
-        for obj, side in zip(objects, ("a", "b")):
-            write_regions(obj, result.regions(side), result.colors(side, one_to_one=one_to_one))
-            write_confidence(obj, confidence)
+        write_correspondence(objects, result, one_to_one)
+        entry = self._pair.entry(result)
+        entry.views["regions"] = {"one_to_one": one_to_one}
+        memory.remember(entry)
+        memory.write_summary(context.scene, self.bl_label, self._pair.names, result)
         matches = result.matches_one_to_one if one_to_one else result.matches
         return (
             f"shapecorr: {len(matches)} region matches between '{objects[0].name}' "
             f"({result.n_regions('a')} regions) and '{objects[1].name}' "
-            f"({result.n_regions('b')} regions), {confidence_text(confidence)}"
+            f"({result.n_regions('b')} regions), {confidence_text(confidence)}{memory.answer_text(result)}"
         )
+
+
+def write_correspondence(objects, result, one_to_one):
+    """Writes a Correspondence's regions, colours and confidence on the two objects."""
+    for obj, side in zip(objects, ("a", "b")):
+        write_regions(obj, result.regions(side), result.colors(side, one_to_one=one_to_one))
+        write_confidence(obj, result.confidence)
 
 
 class SHAPECORR_OT_detect_symmetry(_LibraryOperator, bpy.types.Operator):

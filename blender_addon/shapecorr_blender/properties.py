@@ -7,6 +7,45 @@ from .shapecorr import options as library_options
 _OPTIONS = library_options()
 _DEFAULTS = {name: default for name, _kind, _doc, default in _OPTIONS}
 _DOCS = {name: doc for name, _kind, doc, _default in _OPTIONS}
+_PLACEMENTS = {o.name: o for o in _OPTIONS}["placement"].choices
+#: What each placement does, for the tooltip (docs/placement.md).
+_PLACEMENT_DOCS = {
+    "auto": "Use where the two objects stand only when it is informative (one answer implies "
+    "almost no turn between them, every other a large one); otherwise ignore it. Right for two "
+    "objects in one scene, upright and facing alike, and safe for objects turned at random",
+    "ignore": "Never use where the objects stand: the answer depends on their shapes only",
+    "trust": "The objects stand alike (one scene, one scanner): take the consistent answer that "
+    "implies the least turn between them",
+}
+
+
+class ShapecorrLandmark(bpy.types.PropertyGroup):
+    """One landmark pair: a vertex of one object and its partner on another (Blender's vertex
+    indices); the order of the two objects does not matter."""
+
+    object_1: bpy.props.PointerProperty(type=bpy.types.Object, name="First Object")
+    vertex_1: bpy.props.IntProperty(name="First Vertex", min=0)
+    object_2: bpy.props.PointerProperty(type=bpy.types.Object, name="Second Object")
+    vertex_2: bpy.props.IntProperty(name="Second Vertex", min=0)
+
+
+class ShapecorrAnswer(bpy.types.PropertyGroup):
+    """What the last run answered (the panel's summary; memory.write_summary)."""
+
+    operation: bpy.props.StringProperty(name="Operation")
+    source: bpy.props.StringProperty(name="Source")
+    target: bpy.props.StringProperty(name="Target")
+    verified: bpy.props.BoolProperty(name="Verified")
+    confidence: bpy.props.FloatProperty(name="Confidence")
+    warning: bpy.props.StringProperty(name="Warning")
+    hypothesis: bpy.props.StringProperty(name="Hypothesis")
+    decided_by: bpy.props.StringProperty(name="Decided By")
+    placement_used: bpy.props.BoolProperty(name="Placement Used")
+    has_turn: bpy.props.BoolProperty(name="Has Turn")
+    turn: bpy.props.FloatProperty(name="Turn", description="Degrees")
+    has_runner_up: bpy.props.BoolProperty(name="Has Runner-Up")
+    runner_up: bpy.props.StringProperty(name="Runner-Up")
+    runner_up_cost: bpy.props.FloatProperty(name="Runner-Up Cost")
 
 
 class ShapecorrSettings(bpy.types.PropertyGroup):
@@ -36,6 +75,17 @@ class ShapecorrSettings(bpy.types.PropertyGroup):
         "treated as point clouds)",
         default=False,
     )
+
+    placement: bpy.props.EnumProperty(
+        name="Placement",
+        description="How where the two objects stand is used to choose among the answers "
+        "(a half-turn or a mirror that the shapes alone cannot tell apart)",
+        items=[(name, name.capitalize(), _PLACEMENT_DOCS[name]) for name in _PLACEMENTS],
+        default=_PLACEMENTS[_DEFAULTS["placement"]],
+    )
+    landmarks: bpy.props.CollectionProperty(type=ShapecorrLandmark)
+    landmark_index: bpy.props.IntProperty(name="Active Landmark Pair", default=0, min=0)
+    answer: bpy.props.PointerProperty(type=ShapecorrAnswer)
 
     transfer_vertex_groups: bpy.props.BoolProperty(
         name="Vertex Groups",
@@ -91,4 +141,5 @@ class ShapecorrSettings(bpy.types.PropertyGroup):
             "k_min": self.k_min,
             "k_max": self.k_max,
             "one_to_one": self.one_to_one if one_to_one is None else one_to_one,
+            "placement": self.placement,
         }

@@ -9,8 +9,8 @@ the main thread then writes it in one undo step, so a failure leaves the scene a
 import bpy
 import numpy as np
 
-from . import shapecorr
-from .operators import _STAGES, _LibraryOperator, confidence_text, ordered_selection, read_shape
+from . import memory, shapecorr
+from .operators import _STAGES, PairInput, _LibraryOperator, confidence_text, ordered_selection
 
 #: Point attributes that are Blender's own, never carried.
 _INTERNAL = {"position", "sharp_face", "material_index"}
@@ -73,6 +73,10 @@ class _Item:
         self.values, self.mode = values, mode
         self.data_type, self.domain = data_type, domain
         self.result = None
+
+    def fresh(self):
+        """The same item, not carried yet (to carry it again through another map)."""
+        return _Item(self.kind, self.name, self.target_name, self.values, self.mode, self.data_type, self.domain)
 
 
 def loop_triangles(mesh):
@@ -185,6 +189,40 @@ def write_attribute(target, item):
         attribute.data.foreach_set(_field(item.data_type), values.astype(np.float32).ravel())
 
 
+class Carrying:
+    """What carrying needs besides the map, kept in memory to carry again through another
+    answer: the items (source values), both meshes' loop triangles, the influence limit."""
+
+    def __init__(self, items, faces_a, faces_b, max_influences):
+        self.items, self.faces_a, self.faces_b = items, faces_a, faces_b
+        self.max_influences = max_influences
+
+    def carry(self, shapes, pointwise, progress):
+        """The items carried through ``pointwise`` (a PointwiseMap; its surface map is made
+        here): new items with their results, nothing written."""
+        onto = shapecorr.surface_map(shapes[0], shapes[1], pointwise, progress=progress)
+        items = [item.fresh() for item in self.items]
+        for item in items:
+            if item.mode == "corners":
+                item.result = onto.transfer_corners(shapes[0], self.faces_a, item.values, self.faces_b)
+            else:
+                item.result = onto.transfer(item.values, mode=item.mode, max_influences=self.max_influences)
+        return items
+
+
+def write_carried(target, items):
+    """Writes carried items on the target; returns how many names were written."""
+    for item in items:
+        if item.kind == "groups":
+            write_groups(target, item)
+        elif item.kind == "uv":
+            write_uv(target, item)
+        else:
+            write_attribute(target, item)
+    target.data.update()
+    return sum(len(i.target_name) if i.kind == "groups" else 1 for i in items)
+
+
 class SHAPECORR_OT_transfer(_LibraryOperator, bpy.types.Operator):
     """Carry vertex groups, UV maps, colour and point attributes from the active mesh to the
     other selected mesh, through the correspondence (any pose and body)"""
@@ -200,52 +238,51 @@ class SHAPECORR_OT_transfer(_LibraryOperator, bpy.types.Operator):
         for obj in (source, target):
             if len(obj.data.polygons) == 0:
                 raise ValueError(f"'{obj.name}' has no faces: Transfer needs two meshes with faces")
-        depsgraph = context.evaluated_depsgraph_get()
-        shapes = [read_shape(o, depsgraph, False) for o in (source, target)]
-        self._names = [source.name, target.name]
-        self._repairs = [f"shapecorr: '{o.name}': {r}" for o, s in zip((source, target), shapes) for r in s.repairs]
+        pair = PairInput(context, as_point_cloud=False)
+        self._pair = pair
+        self._names = list(pair.names)
+        self._repairs = pair.repairs
         items = items_to_carry(source, settings)
-        faces_a = loop_triangles(source.data)[0]
-        faces_b = loop_triangles(target.data)[0]
         if not items:
             raise ValueError(f"'{source.name}' has nothing of what the Transfer settings ask to carry")
-        options = settings.library_options()
-        max_influences = settings.transfer_max_influences
+        carrying = Carrying(items, loop_triangles(source.data)[0], loop_triangles(target.data)[0],
+                            settings.transfer_max_influences)
+        self._carrying = carrying
+        # The map Show Map or an earlier Transfer made from the same input (perhaps the other
+        # answer the user took) is used as it is.
+        kept = pair.kept_map()
+        self._kept = kept
+        pointwise = None if kept is None else kept.current(context.scene)
+        arguments = pair.arguments()
 
         def work(progress):
-            pointwise = shapecorr.pointwise_map(shapes[0], shapes[1], progress=progress, **options)
-            onto = shapecorr.surface_map(shapes[0], shapes[1], pointwise, progress=progress)
-            for item in items:
-                if item.mode == "corners":
-                    item.result = onto.transfer_corners(shapes[0], faces_a, item.values, faces_b)
-                else:
-                    item.result = onto.transfer(item.values, mode=item.mode, max_influences=max_influences)
-            return _Carried(pointwise, items)
+            answer = pointwise
+            if answer is None:
+                answer = shapecorr.pointwise_map(pair.shapes[0], pair.shapes[1], progress=progress, **arguments)
+            return _Carried(answer, carrying.carry(pair.shapes, answer, progress))
 
         return work
 
     def apply(self, context, result):
         source, target = (bpy.data.objects[name] for name in self._names)
-        for item in result.items:
-            if item.kind == "groups":
-                write_groups(target, item)
-            elif item.kind == "uv":
-                write_uv(target, item)
-            else:
-                write_attribute(target, item)
-        target.data.update()
-        carried = sum(len(i.target_name) if i.kind == "groups" else 1 for i in result.items)
+        carried = write_carried(target, result.items)
+        entry = self._kept or self._pair.entry(result.pointwise)
+        entry.views["transfer"] = self._carrying
+        memory.remember(entry)
+        memory.write_summary(context.scene, self.bl_label, self._pair.names, result.pointwise)
+        reused = ", the map kept from the last run" if self._kept is not None else ""
         return (
-            f"shapecorr: {carried} items carried from '{source.name}' to '{target.name}', "
-            f"{confidence_text(result.confidence)}"
+            f"shapecorr: {carried} items carried from '{source.name}' to '{target.name}'{reused}, "
+            f"{confidence_text(result.confidence)}{memory.answer_text(result.pointwise)}"
         )
 
 
 class _Carried:
-    """What the worker thread computed: the carried items and the map's confidence and
-    warning (reported by the operator)."""
+    """What the worker thread computed: the map, the carried items and the map's confidence
+    and warning (reported by the operator)."""
 
     def __init__(self, pointwise, items):
+        self.pointwise = pointwise
         self.items = items
         self.confidence = pointwise.confidence
         self.warning = pointwise.warning

@@ -292,10 +292,13 @@ def test_modifiers_that_change_the_vertex_count_are_reported(addon):
 def test_settings_default_to_the_library_defaults(addon):
     fresh_scene()
     settings = bpy.context.scene.shapecorr
-    defaults = {name: value for name, _, _, value in addon.shapecorr.options()}
+    options = {o.name: o for o in addon.shapecorr.options()}
+    # A choice (placement) by its name, as the panel passes it.
+    defaults = {name: o.choices[o.default] if o.choices else o.default for name, o in options.items()}
     passed = settings.library_options()
     # Every option the panel passes is a name of the library's one table, with its default.
     assert passed and set(passed) <= set(defaults), set(passed) - set(defaults)
+    assert "placement" in passed
     for name, value in passed.items():
         assert value == defaults[name], name
         assert getattr(settings, name) == defaults[name], name
@@ -525,3 +528,404 @@ def test_transfer_with_nothing_to_carry_says_so(addon):
     select(a, b)
     with pytest.raises(RuntimeError, match="nothing of what"):
         bpy.ops.shapecorr.transfer()
+
+
+# ------------------------------------------------------------- Check and correct the answer
+
+
+def answers_module():
+    return sys.modules["shapecorr_ext.answers"]
+
+
+def memory_module():
+    return sys.modules["shapecorr_ext.memory"]
+
+
+def world_shape(addon, obj):
+    """The library's shape of ``obj`` as the add-on reads it (world space, its triangles)."""
+    return library_shape(addon, obj)
+
+
+def point_colors(obj, name):
+    """A point colour attribute as (n, 4) sRGB bytes."""
+    n = len(obj.data.vertices)
+    rgba = np.empty(4 * n, dtype=np.float32)
+    obj.data.color_attributes[name].data.foreach_get("color_srgb", rgba)
+    return np.round(rgba.reshape(n, 4) * 255).astype(np.uint8)
+
+
+def expected_position_colors(vertices):
+    """Each coordinate scaled from its range to 0..255 (the command line's a_colors.ply),
+    written again here from its definition."""
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    return np.floor((vertices - low) / (high - low) * 255.0 + 0.5).astype(np.uint8)
+
+
+def world_vertices(obj):
+    n = len(obj.data.vertices)
+    co = np.empty(3 * n, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    return co.reshape(n, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def two_figures(addon, poses=(0, 3), rotation_z=0.0):
+    fresh_scene()
+    (va, ta), (vb, tb) = figures(addon, "humanoid", poses)
+    a = add_object("A", va, ta)
+    b = add_object("B", vb, tb, location=(3.0, 0.0, 0.0), rotation_z=rotation_z)
+    select(a, b)
+    return a, b
+
+
+def make_active_vertex(obj, index):
+    """In Edit Mode: ``index`` becomes the only selected vertex of ``obj`` and the active one."""
+    import bmesh
+
+    mesh = bmesh.from_edit_mesh(obj.data)
+    mesh.verts.ensure_lookup_table()
+    for vertex in mesh.verts:
+        vertex.select = False
+    mesh.select_history.clear()
+    if index is not None:
+        mesh.verts[index].select = True
+        mesh.select_history.add(mesh.verts[index])
+    bmesh.update_edit_mesh(obj.data)
+
+
+def add_landmark(a, b, vertex_a, vertex_b):
+    """A landmark pair written directly into the scene's list (as Add Pair stores one)."""
+    pair = bpy.context.scene.shapecorr.landmarks.add()
+    pair.object_1, pair.vertex_1, pair.object_2, pair.vertex_2 = a, vertex_a, b, vertex_b
+    return pair
+
+
+def test_landmark_pairs_are_added_in_edit_mode_removed_and_cleared(addon):
+    a, b = two_figures(addon)
+    settings = bpy.context.scene.shapecorr
+    assert not bpy.ops.shapecorr.landmark_add.poll(), "Object Mode: no pair to take"
+    bpy.ops.object.mode_set(mode="EDIT")
+    assert {o.name for o in bpy.context.view_layer.objects if o.mode == "EDIT"} == {"A", "B"}
+    make_active_vertex(a, 10)
+    make_active_vertex(b, 20)
+    assert bpy.ops.shapecorr.landmark_add() == {"FINISHED"}
+    make_active_vertex(a, 30)
+    make_active_vertex(b, 40)
+    assert bpy.ops.shapecorr.landmark_add() == {"FINISHED"}
+    # A vertex already in a pair is refused (the library takes one partner per vertex).
+    make_active_vertex(b, 20)
+    with pytest.raises(RuntimeError, match="already in landmark pair 1"):
+        bpy.ops.shapecorr.landmark_add()
+    # No active vertex on one mesh: said, nothing added.
+    make_active_vertex(b, None)
+    with pytest.raises(RuntimeError, match="'B': make one vertex active"):
+        bpy.ops.shapecorr.landmark_add()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    stored = [(p.object_1.name, p.vertex_1, p.object_2.name, p.vertex_2) for p in settings.landmarks]
+    assert stored == [("A", 10, "B", 20), ("A", 30, "B", 40)]
+    # The pairs as the library gets them: A's vertex first, whichever object is active.
+    pairs_of = sys.modules["shapecorr_ext.landmarks"].landmark_pairs
+    assert pairs_of(bpy.context.scene, a, b) == [(10, 20), (30, 40)]
+    assert pairs_of(bpy.context.scene, b, a) == [(20, 10), (40, 30)]
+    settings.landmark_index = 0
+    assert bpy.ops.shapecorr.landmark_remove() == {"FINISHED"}
+    assert [(p.vertex_1, p.vertex_2) for p in settings.landmarks] == [(30, 40)]
+    assert bpy.ops.shapecorr.landmark_clear() == {"FINISHED"}
+    assert len(settings.landmarks) == 0
+    assert not bpy.ops.shapecorr.landmark_remove.poll()
+
+
+def test_landmarks_survive_save_and_reload_and_the_kept_answer_does_not(addon, tmp_path):
+    a, b = two_figures(addon)
+    add_landmark(a, b, 10, 20)
+    add_landmark(b, a, 40, 30)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    path = str(tmp_path / "landmarks.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    fresh_scene()
+    assert len(bpy.context.scene.shapecorr.landmarks) == 0
+    bpy.ops.wm.open_mainfile(filepath=path)
+    scene = bpy.context.scene
+    stored = [(p.object_1.name, p.vertex_1, p.object_2.name, p.vertex_2) for p in scene.shapecorr.landmarks]
+    assert stored == [("A", 10, "B", 20), ("B", 40, "A", 30)]
+    a, b = bpy.data.objects["A"], bpy.data.objects["B"]
+    assert sys.modules["shapecorr_ext.landmarks"].landmark_pairs(scene, a, b) == [(10, 20), (30, 40)]
+    # The panel's summary is saved with the file; the library's result is not.
+    assert scene.shapecorr.answer.operation == "Match Regions"
+    select(a, b)
+    with pytest.raises(RuntimeError, match="no answer kept for 'A' -> 'B'"):
+        bpy.ops.shapecorr.other_answer()
+
+
+def test_show_map_colours_the_target_by_where_it_lands_like_the_library(addon):
+    a, b = two_figures(addon, rotation_z=0.7)
+    bpy.context.scene.shapecorr.placement = "ignore"  # B is turned: the shapes alone decide
+    try:
+        assert bpy.ops.shapecorr.show_map() == {"FINISHED"}
+    finally:
+        bpy.context.scene.shapecorr.placement = "auto"
+    name = answers_module().MAP_ATTRIBUTE
+    world_a = world_vertices(a)
+    colors_a = expected_position_colors(world_a)
+    got_a, got_b = point_colors(a, name), point_colors(b, name)
+    assert np.array_equal(got_a[:, :3], colors_a)
+    assert np.all(got_a[:, 3] == 255) and np.all(got_b[:, 3] == 255)
+    expected = addon.shapecorr.pointwise_map(world_shape(addon, a), world_shape(addon, b), placement="ignore")
+    assert np.array_equal(got_b[:, :3], colors_a[expected.map_b_to_a])
+    for obj in (a, b):
+        assert obj.data.color_attributes.active_color_name == name
+        assert obj.data.color_attributes[name].domain == "POINT"
+    # The figures share their vertex order: a right map gives most vertices of B the colour
+    # of the same vertex of A (a swap would not).
+    close = np.all(np.abs(got_b[:, :3].astype(int) - colors_a.astype(int)) <= 20, axis=1)
+    assert np.mean(close) > 0.8, np.mean(close)
+    answer = bpy.context.scene.shapecorr.answer
+    assert (answer.operation, answer.source, answer.target) == ("Show Map", "A", "B")
+    assert answer.hypothesis == expected.hypothesis
+    assert answer.confidence == pytest.approx(expected.confidence, abs=1e-6)
+
+
+def test_show_map_is_undoable(addon):
+    assert {"REGISTER", "UNDO"} <= answers_module().SHAPECORR_OT_show_map.bl_options
+    two_figures(addon)
+    bpy.ops.ed.undo_push(message="before shapecorr")
+    assert bpy.ops.shapecorr.show_map() == {"FINISHED"}
+    name = answers_module().MAP_ATTRIBUTE
+    assert name in bpy.data.objects["B"].data.color_attributes
+    if not bpy.ops.ed.undo.poll():
+        pytest.skip("ed.undo needs a window, which headless bpy does not have")
+    bpy.ops.ed.undo()
+    for obj_name in ("A", "B"):
+        assert name not in bpy.data.objects[obj_name].data.color_attributes
+
+
+def test_landmarks_reach_the_library_and_map_exactly_to_their_partners(addon):
+    """A landmark the figures' own vertex order contradicts (vertex 2000 of B to vertex 10 of
+    A): the map sends it exactly there, as the library's own map with that landmark does."""
+    a, b = two_figures(addon)
+    add_landmark(a, b, 10, 2000)
+    add_landmark(b, a, 700, 1500)  # named B first: the add-on turns it round
+    assert bpy.ops.shapecorr.show_map() == {"FINISHED"}
+    colors_a = expected_position_colors(world_vertices(a))
+    got_b = point_colors(b, answers_module().MAP_ATTRIBUTE)[:, :3]
+    assert np.array_equal(got_b[2000], colors_a[10])
+    assert np.array_equal(got_b[700], colors_a[1500])
+    assert not np.array_equal(colors_a[10], colors_a[2000])
+    sc = addon.shapecorr
+    expected = sc.pointwise_map(world_shape(addon, a), world_shape(addon, b), landmarks=[(10, 2000), (1500, 700)])
+    assert np.array_equal(got_b, colors_a[expected.map_b_to_a])
+
+
+@pytest.mark.parametrize("operation", ["match_regions", "transfer"])
+@pytest.mark.parametrize(
+    "case, message",
+    [("out_of_range", "landmark pair 1: 'Target' has no vertex 99999"), ("two_partners", "landmarks")],
+)
+def test_a_bad_landmark_is_reported_and_leaves_the_scene_unchanged(addon, operation, case, message):
+    a, b, _, _ = rigged_source(addon)
+    if case == "out_of_range":
+        add_landmark(a, b, 5, 99999)
+    else:
+        # One vertex of A with two partners (Add Pair refuses it; a script need not).
+        add_landmark(a, b, 5, 6)
+        add_landmark(a, b, 5, 7)
+    before = {o.name: (len(o.vertex_groups), len(o.data.color_attributes), len(o.data.attributes)) for o in (a, b)}
+    with pytest.raises(RuntimeError, match=message):
+        getattr(bpy.ops.shapecorr, operation)()
+    after = {o.name: (len(o.vertex_groups), len(o.data.color_attributes), len(o.data.attributes)) for o in (a, b)}
+    assert after == before
+    assert bpy.context.scene.shapecorr.answer.operation == ""
+    assert memory_module().entry(("Source", "Target")) is None
+
+
+@pytest.mark.parametrize("placement, used", [("ignore", False), ("trust", True)])
+def test_the_placement_setting_reaches_the_library(addon, placement, used):
+    """Trust always takes the answer of least turn (the placement is used), Ignore never: the
+    panel's summary says which, as the library's own result with that setting does."""
+    a, b = two_figures(addon)
+    settings = bpy.context.scene.shapecorr  # after the new scene: the old one is freed
+    settings.placement = placement
+    try:
+        assert settings.library_options()["placement"] == placement
+        assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    finally:
+        settings.placement = "auto"
+    expected = addon.shapecorr.match(world_shape(addon, a), world_shape(addon, b), placement=placement)
+    answer = settings.answer
+    assert expected.placement_used is used
+    assert answer.placement_used is used
+    assert answer.hypothesis == expected.hypothesis
+    assert answer.decided_by == expected.decided_by
+
+
+def test_use_other_answer_recolours_the_regions_with_the_runner_up(addon, capfd):
+    a, b = two_figures(addon)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    sc = addon.shapecorr
+    expected = sc.match(world_shape(addon, a), world_shape(addon, b))
+    other = expected.other_answer()
+    assert other is not None, "the figures' mirror is a different answer"
+    assert other.hypothesis != expected.hypothesis
+    first = [attribute_arrays(o)[0] for o in (a, b)]
+    reports(capfd)
+    assert bpy.ops.shapecorr.other_answer() == {"FINISHED"}
+    found = reports(capfd)
+    assert any(f"other answer '{other.hypothesis}'" in text for level, text in found if level == "Info"), found
+    for obj, side, before in zip((a, b), "ab", first):
+        rgba, regions = attribute_arrays(obj)
+        assert np.array_equal(rgba, other.colors(side)), side
+        assert np.array_equal(regions, other.regions(side).astype(np.int32))
+    assert not all(np.array_equal(attribute_arrays(o)[0], f) for o, f in zip((a, b), first))
+    answer = bpy.context.scene.shapecorr.answer
+    assert (answer.operation, answer.hypothesis, answer.decided_by) == (
+        "Use Other Answer", other.hypothesis, "other answer")
+    # Once more: the runner-up of the other answer, again from memory.
+    again = other.other_answer()
+    assert bpy.ops.shapecorr.other_answer() == {"FINISHED"}
+    assert bpy.context.scene.shapecorr.answer.hypothesis == again.hypothesis
+
+
+def test_use_other_answer_carries_again_through_the_runner_up(addon):
+    a, b, _, _ = rigged_source(addon)
+    settings = bpy.context.scene.shapecorr
+    settings.transfer_uvs = False
+    try:
+        assert bpy.ops.shapecorr.transfer() == {"FINISHED"}
+        names = ("upper", "lower", "mask")
+        first = np.stack([group_weights(b, n) for n in names], axis=1)
+        assert bpy.ops.shapecorr.show_map() == {"FINISHED"}  # the same map, kept
+        assert bpy.ops.shapecorr.other_answer() == {"FINISHED"}
+    finally:
+        settings.transfer_uvs = True
+    shapes = [library_shape(addon, o) for o in (a, b)]
+    sc = addon.shapecorr
+    pointwise = sc.pointwise_map(*shapes)
+    other = pointwise.other_answer()
+    assert other is not None
+    onto = sc.surface_map(shapes[0], shapes[1], other)
+    source = np.stack([group_weights(a, n) for n in names], axis=1)
+    expected = onto.transfer(source, mode="weights", max_influences=4)
+    got = np.stack([group_weights(b, n) for n in names], axis=1)
+    assert np.allclose(got, expected.astype(np.float32), atol=1e-6)
+    assert not np.allclose(got, first, atol=1e-3), "the other answer carries elsewhere"
+    # Show Map was redone with it too.
+    colors_a = expected_position_colors(world_vertices(a))
+    got_b = point_colors(b, answers_module().MAP_ATTRIBUTE)[:, :3]
+    assert np.array_equal(got_b, colors_a[other.map_b_to_a])
+    # A Transfer now uses the answer taken (kept in memory), not a new match.
+    assert bpy.ops.shapecorr.transfer() == {"FINISHED"}
+    again = np.stack([group_weights(b, n) for n in names], axis=1)
+    assert np.allclose(again, got, atol=1e-6)
+
+
+def test_use_other_answer_says_when_there_is_none(addon):
+    a, b = two_figures(addon)
+    with pytest.raises(RuntimeError, match="no answer kept"):
+        bpy.ops.shapecorr.other_answer()
+    settings = bpy.context.scene.shapecorr
+    settings.one_to_one = False
+    try:
+        assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    finally:
+        settings.one_to_one = True
+    before = attribute_arrays(b)[0]
+    with pytest.raises(RuntimeError, match="not verified"):
+        bpy.ops.shapecorr.other_answer()
+    assert np.array_equal(attribute_arrays(b)[0], before)
+    # A mesh moved since the answer: refused, not applied to another shape.
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    b.location.x += 1.0
+    bpy.context.view_layer.update()
+    with pytest.raises(RuntimeError, match="changed since the last run"):
+        bpy.ops.shapecorr.other_answer()
+
+
+
+def test_use_other_answer_without_a_runner_up_says_so_and_changes_nothing(addon):
+    """Two quadrupeds (1500 vertices, poses 0 and 1): every answer the library verifies gives
+    the same map (measured), so there is no other answer."""
+    fresh_scene()
+    sc = addon.shapecorr
+    shapes = [sc.Shape.figure("quadruped", pose, 1500) for pose in (0, 1)]
+    a = add_object("A", shapes[0].vertices, shapes[0].triangles)
+    b = add_object("B", shapes[1].vertices, shapes[1].triangles, location=(3.0, 0.0, 0.0))
+    select(a, b)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    expected = sc.match(world_shape(addon, a), world_shape(addon, b))
+    assert expected.confidence is not None and expected.runner_up is None
+    assert expected.other_answer() is None
+    assert "Runner-up: none" in [text for kind, text in draw_panels(addon) if kind == "label"]
+    before = [attribute_arrays(o)[0] for o in (a, b)]
+    with pytest.raises(RuntimeError, match=f"the answer '{expected.hypothesis}' has no runner-up"):
+        bpy.ops.shapecorr.other_answer()
+    assert all(np.array_equal(attribute_arrays(o)[0], f) for o, f in zip((a, b), before))
+    assert bpy.context.scene.shapecorr.answer.operation == "Match Regions"
+
+
+class RecordingLayout:
+    """Stands in for a panel's layout (headless Blender draws no panel): records the labels,
+    properties and operators drawn, in order."""
+
+    def __init__(self, record=None):
+        self.record = [] if record is None else record
+        self.enabled = True
+
+    def _sub(self, *args, **kwargs):
+        return RecordingLayout(self.record)
+
+    column = row = box = split = _sub
+
+    def label(self, text="", icon="NONE"):
+        self.record.append(("label", text))
+
+    def prop(self, data, name, **kwargs):
+        assert hasattr(data, name), name
+        self.record.append(("prop", name))
+
+    def operator(self, idname, **kwargs):
+        category, name = idname.split(".")
+        assert hasattr(getattr(bpy.ops, category), name), idname
+        self.record.append(("operator", idname))
+
+    def template_list(self, list_type, list_id, data, name, active_data, active_name, **kwargs):
+        assert hasattr(bpy.types, list_type), list_type
+        assert hasattr(data, name) and hasattr(active_data, active_name)
+        self.record.append(("list", name))
+
+
+def draw_panels(addon):
+    """What every panel of the add-on draws now, as RecordingLayout records."""
+    layout = RecordingLayout()
+    panel = addon.panel
+    for cls in (panel.SHAPECORR_PT_panel, panel.SHAPECORR_PT_answer, panel.SHAPECORR_PT_landmarks,
+                panel.SHAPECORR_PT_transfer):
+        fake = type("Panel", (), {"layout": layout})()
+        cls.draw(fake, bpy.context)
+    return layout.record
+
+
+def test_the_panel_shows_the_answer_the_buttons_and_the_landmarks(addon):
+    a, b = two_figures(addon)
+    drawn = draw_panels(addon)
+    assert ("prop", "placement") in drawn
+    for idname in ("shapecorr.show_map", "shapecorr.other_answer", "shapecorr.landmark_add",
+                   "shapecorr.landmark_remove", "shapecorr.landmark_clear"):
+        assert ("operator", idname) in drawn, idname
+    assert ("list", "landmarks") in drawn
+    assert ("label", "No answer yet") in drawn
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    expected = addon.shapecorr.match(world_shape(addon, a), world_shape(addon, b))
+    labels = [text for kind, text in draw_panels(addon) if kind == "label"]
+    assert "Match Regions: A \u2192 B" in labels, labels
+    assert f"Confidence {expected.confidence:.2f}" in labels, labels
+    assert f"Answer: {expected.hypothesis} (by {expected.decided_by})" in labels, labels
+    placement = [t for t in labels if t.startswith("Placement: ")]
+    assert placement == [f"Placement: {'used' if expected.placement_used else 'not used'}, "
+                         f"turn {expected.turn_degrees:.0f}\u00b0"], labels
+    runner_up = expected.runner_up
+    if runner_up is None:
+        assert "Runner-up: none" in labels, labels
+    else:
+        field = memory_module()._field
+        text = f"Runner-up: {field(runner_up, 'hypothesis')}, cost {field(runner_up, 'cost'):.3g}"
+        assert text in labels, labels
