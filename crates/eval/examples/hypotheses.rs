@@ -120,32 +120,8 @@ fn one_pair(
 ) -> shapecorr::Result<()> {
     store.load(&pair.source, true, true)?;
     store.load(&pair.target, true, false)?;
+    let (b, params) = &turned_and_landmarks(store, pair, params, (rotate, n_landmarks))?;
     let a = &store.get(&pair.source).shape;
-    let b_given = store.get(&pair.target).shape.clone();
-    let b = &match rotate {
-        Some(seed) => {
-            let r = random_rotation(seed ^ fnv(&format!("{}>{}", pair.source, pair.target)));
-            b_given.with_vertices(
-                b_given
-                    .vertices()
-                    .iter()
-                    .map(|p| std::array::from_fn(|i| (0..3).map(|j| r[i][j] * p[j]).sum()))
-                    .collect(),
-            )?
-        }
-        None => b_given,
-    };
-    let mut params = params.clone();
-    if n_landmarks > 0 {
-        let (truth, _) = store.dataset.ground_truth(
-            &pair.source,
-            &pair.target,
-            a.n_vertices(),
-            b.n_vertices(),
-        )?;
-        params.landmarks = landmarks_from_truth(b.vertices(), &truth, n_landmarks);
-    }
-    let params = &params;
     let (basis_a, basis_b) = (
         &store.basis(&pair.source).basis,
         &store.basis(&pair.target).basis,
@@ -275,6 +251,40 @@ fn spread(pairs: &[Pair], n: Option<usize>) -> Vec<Pair> {
         Some(n) if n < pairs.len() => (0..n).map(|i| pairs[i * pairs.len() / n].clone()).collect(),
         _ => pairs.to_vec(),
     }
+}
+
+/// B, turned at random when `rotate` gives a seed, and the parameters with `n_landmarks`
+/// landmarks from the ground truth.
+fn turned_and_landmarks(
+    store: &mut ShapeStore,
+    pair: &Pair,
+    params: &Params,
+    (rotate, n_landmarks): (Option<u64>, usize),
+) -> shapecorr::Result<(shapecorr::Shape, Params)> {
+    let n_a = store.get(&pair.source).shape.n_vertices();
+    let b_given = store.get(&pair.target).shape.clone();
+    let b = match rotate {
+        Some(seed) => {
+            let r = random_rotation(seed ^ fnv(&format!("{}>{}", pair.source, pair.target)));
+            b_given.with_vertices(
+                b_given
+                    .vertices()
+                    .iter()
+                    .map(|p| std::array::from_fn(|i| (0..3).map(|j| r[i][j] * p[j]).sum()))
+                    .collect(),
+            )?
+        }
+        None => b_given,
+    };
+    let mut params = params.clone();
+    if n_landmarks > 0 {
+        let (truth, _) =
+            store
+                .dataset
+                .ground_truth(&pair.source, &pair.target, n_a, b.n_vertices())?;
+        params.landmarks = landmarks_from_truth(b.vertices(), &truth, n_landmarks);
+    }
+    Ok((b, params))
 }
 
 /// A rotation drawn uniformly (a normalised random quaternion), from `seed`.
