@@ -598,6 +598,17 @@ pub fn fmap_to_p2p(
     phi_b: MatRef<'_, f64>,
     cancel: &Cancel,
 ) -> Result<Vec<u32>> {
+    let embedding_a = embedding_through(fmap_ab, phi_a);
+    nearest_rows(
+        embedding_a.as_ref(),
+        phi_b.subcols(0, fmap_ab.nrows()),
+        cancel,
+    )
+}
+
+/// A's vertices in B's spectral coordinates through `fmap_ab` (`k_b x k_a`): the rows of
+/// `phi_a[:, :k_a] C^T`, which [`fmap_to_p2p`] compares with B's rows.
+pub fn embedding_through(fmap_ab: MatRef<'_, f64>, phi_a: MatRef<'_, f64>) -> Mat<f64> {
     let (k_b, k_a) = (fmap_ab.nrows(), fmap_ab.ncols());
     let mut embedding_a = Mat::<f64>::zeros(phi_a.nrows(), k_b);
     matmul(
@@ -608,7 +619,7 @@ pub fn fmap_to_p2p(
         1.0,
         Par::Seq,
     );
-    nearest_rows(embedding_a.as_ref(), phi_b.subcols(0, k_b), cancel)
+    embedding_a
 }
 
 /// The functional map `C_ab = Phi_b^T M_b Pi_ba Phi_a` (`k_b x k_a`) of a pointwise map

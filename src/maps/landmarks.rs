@@ -5,8 +5,9 @@
 //! landmark of B maps to its partner in the answer. Two pairs on one side of a body settle
 //! every symmetric choice.
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par};
+use faer::MatRef;
+
+use crate::maps::fmap::embedding_through;
 
 use crate::shape::Shape;
 use crate::{Error, Result};
@@ -90,16 +91,8 @@ pub fn landmark_error(
     if landmarks.is_empty() {
         return None;
     }
-    let (k_b, k_a) = (fmap_ab.nrows(), fmap_ab.ncols());
-    let mut embedding_a = Mat::<f64>::zeros(phi_a.nrows(), k_b);
-    matmul(
-        embedding_a.as_mut(),
-        Accum::Replace,
-        phi_a.subcols(0, k_a),
-        fmap_ab.transpose(),
-        1.0,
-        Par::Seq,
-    );
+    let k_b = fmap_ab.nrows();
+    let embedding_a = embedding_through(fmap_ab, phi_a);
     let mut sum = 0.0;
     for &[la, lb] in landmarks {
         let image = (0..embedding_a.nrows())

@@ -6,7 +6,12 @@ makes, their map errors, and how often the rule changes the intrinsic choice whe
 turned at random (each hypothesis's implied rotation R becomes R Q^T for a random Q; the
 placement hypothesis is left out there, its map comes from the frame).
 
-    python3 crates/eval/scripts/placement_rules.py ORACLE.jsonl ... [--rotations N]
+    python3 crates/eval/scripts/placement_rules.py ORACLE.jsonl ... [--rotations N] [--report]
+
+`--report` prints, per dataset, the map errors of the default rule and of `ignore`, and the
+confidence curve of both (the confidence replayed as `hypotheses::confidence` computes it:
+competitors the frame rules out are not counted; a close call caps it as `Verdict::settle`
+does; distances between maps are the full-resolution ones, the library uses samples').
 """
 import json
 import math
@@ -97,15 +102,104 @@ def summary(errors):
     return f"mean {sum(e)/n:.4f} median {e[n//2]:.4f} worst {e[-1]:.3f} failed {sum(x > 0.05 for x in e)}/{n}"
 
 
+COST_SCALE, MARGIN_SCALE, FULL_MARGIN_SCALE = 0.5, 0.05, 0.05
+# The library's rule: NEAR_TURN, FAR_TURN, PLACEMENT_COST_RATIO (src/maps/placement.rs).
+RULE = (30, 100, 1.35)
+
+
+def confidence(hs, pick, ruled):
+    best = hs[pick]["cost"]
+    consistency = math.exp(-best / COST_SCALE)
+    rivals = [h["cost"] for i, h in enumerate(hs) if h["dist"][pick] > DIFFERENT_MAP and not ruled[i]]
+    if not rivals:
+        return consistency
+    runner = min(rivals)
+    rel = (runner - best) / max(runner, 1e-12)
+    return consistency * (1 - math.exp(-max(rel, 0) / MARGIN_SCALE))
+
+
+def decide(hs, placement):
+    """The library's choice and confidence for `placement` ("auto" or "ignore")."""
+    with_own = placement != "ignore"
+    idx = [i for i, h in enumerate(hs) if with_own or h["hypothesis"] != "placement"]
+    sub = [hs[i] for i in idx]
+    turns = [h["turn"] for h in sub]
+    p = frame_pick(sub, turns, RULE) if with_own else None
+    if p is not None:
+        ruled = [h["dist"][p] > DIFFERENT_MAP and turns[i] > RULE[0] for i, h in enumerate(sub)]
+        return idx[p], confidence(sub, p, ruled)
+    # By cost, as by_cost, with the close call's cap on the confidence.
+    cost = lambda i: sub[i]["cost"]
+    chosen = min(range(len(sub)), key=lambda i: (cost(i), i))
+    definite = [i for i in range(len(sub)) if sub[i]["hypothesis"] != "symmetric"]
+    if sub[chosen]["hypothesis"] == "symmetric":
+        same = [i for i in definite if sub[i]["dist"][chosen] <= DIFFERENT_MAP]
+        within = [i for i in definite if cost(i) < SYMMETRIC_YIELDS * cost(chosen)]
+        if same or within:
+            chosen = min(same or within, key=lambda i: (cost(i), i))
+    none = [False] * len(sub)
+    conf = confidence(sub, chosen, none)
+    rivals = [i for i in definite if i != chosen and sub[i]["dist"][chosen] > DIFFERENT_MAP]
+    if rivals:
+        r = min(rivals, key=lambda i: (cost(i), i))
+        if cost(r) < CLOSE_CALL * cost(chosen):
+            full = lambda i: sub[i]["orient_full"] * sub[i]["cover_full"]
+            if full(r) > full(chosen):
+                rel = (full(r) - full(chosen)) / max(full(r), 1e-12)
+                c2 = math.exp(-cost(r) / COST_SCALE) * (1 - math.exp(-rel / FULL_MARGIN_SCALE))
+                return idx[r], min(max(c2, 0.0), conf)
+    return idx[chosen], conf
+
+
+def report(data):
+    by_set = defaultdict(lambda: {"auto": [], "ignore": []})
+    for key, hs in sorted(data.items()):
+        if any("error" not in h for h in hs):
+            continue
+        for mode in ("auto", "ignore"):
+            pick, conf = decide(hs, mode)
+            by_set[key[0]][mode].append((hs[pick]["error"], f"{key[1]} -> {key[2]}", conf))
+    print("| dataset | placement | pairs | mean | median | worst pair | above 0.05 |")
+    print("|---|---|---|---|---|---|---|")
+    for name, modes in sorted(by_set.items()):
+        for mode in ("auto", "ignore"):
+            rows = sorted(modes[mode])
+            n = len(rows)
+            worst = rows[-1]
+            print(f"| {name} | {mode} | {n} | {sum(r[0] for r in rows)/n:.4f} | {rows[n//2][0]:.4f} | "
+                  f"{worst[0]:.4f} ({worst[1]}) | {sum(r[0] > 0.05 for r in rows)} |")
+    print()
+    print("| threshold | failed flagged (auto) | good flagged (auto) | failed flagged (ignore) | good flagged (ignore) |")
+    print("|---|---|---|---|---|")
+    everything = {m: [r for modes in by_set.values() for r in modes[m]] for m in ("auto", "ignore")}
+    for t in (0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.6, 0.7):
+        cells = []
+        for m in ("auto", "ignore"):
+            bad = [c for e, _, c in everything[m] if e > 0.05]
+            good = [c for e, _, c in everything[m] if e <= 0.05]
+            cells.append(f"{sum(c < t for c in bad)}/{len(bad)}")
+            cells.append(f"{sum(c < t for c in good)}/{len(good)} ({100*sum(c < t for c in good)/max(len(good),1):.0f}%)")
+        print(f"| {t} | {cells[0]} | {cells[1]} | {cells[2]} | {cells[3]} |")
+    print()
+    for m in ("auto",):
+        for e, name, c in sorted(everything[m], reverse=True):
+            if e > 0.05:
+                print(f"failed ({m}): {name} {e:.3f} confidence {c:.2f}")
+
+
 def main():
     args = sys.argv[1:]
+    if "--report" in args:
+        args.remove("--report")
+        report(pairs(args))
+        return
     n_rot = 0
     if "--rotations" in args:
         i = args.index("--rotations")
         n_rot = int(args[i + 1])
         del args[i : i + 2]
     data = pairs(args)
-    rules = [(30, 150, 1.5), (30, 100, 3.0), (30, 100, 1.5), (30, 100, 1.3), (20, 120, 1.5), (45, 90, 1.5), (30, 150, 3.0), (20, 160, 1.5)]
+    rules = [RULE, (30, 100, 3.0), (30, 100, 1.5), (30, 150, 1.5), (30, 100, 1.2), (30, 120, 1.35), (45, 90, 1.35), (20, 100, 1.35)]
     base = []
     per_rule = {r: [] for r in rules}
     changes = {r: [] for r in rules}
