@@ -143,9 +143,13 @@
 // Repair flag: leave out far vertices and a point cloud's isolated points.
 #define SC_REPAIR_OUTLIERS 4
 
+// Repair flag: join a mesh's pieces that come close, for matching (no face is added;
+// `Repairs::join_gap`).
+#define SC_REPAIR_JOIN 8
+
 // Every repair (what `sc_shape_new_mesh`, `sc_shape_new_point_cloud` and `sc_shape_read`
 // make).
-#define SC_REPAIR_ALL ((SC_REPAIR_WELD | SC_REPAIR_DEBRIS) | SC_REPAIR_OUTLIERS)
+#define SC_REPAIR_ALL (((SC_REPAIR_WELD | SC_REPAIR_DEBRIS) | SC_REPAIR_OUTLIERS) | SC_REPAIR_JOIN)
 
 // No repair: the shape is used as given.
 #define SC_REPAIR_NONE 0
@@ -558,7 +562,7 @@ const char *sc_correspondence_warning(const sc_correspondence *correspondence);
 // The name of a verified hypothesis: `which` is `SC_ANSWER_CHOSEN` (the answer returned) or
 // `SC_ANSWER_RUNNER_UP` (the cheapest other hypothesis whose map differs, the one
 // `sc_correspondence_other_answer` gives). Names: `"answer"`, `"mirror"`, `"symmetric"`,
-// `"alternative N"`, `"placement"` (docs/placement.md). NULL when the answer was not
+// `"alternative G.O"`, `"placement"` (docs/placement.md). NULL when the answer was not
 // verified (`sc_correspondence_confidence` is NaN), when there is no runner-up, and for
 // NULL or a bad `which`. The string belongs to `correspondence`: valid until it is freed.
 //

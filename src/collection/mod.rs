@@ -228,10 +228,21 @@ pub struct Batch {
 }
 
 impl Batch {
-    /// A batch with these settings (checked here, before any work).
+    /// A batch with these settings (checked here, before any work). Landmarks name vertices
+    /// of one pair, so a batch with landmarks is [`crate::Error::InvalidParameter`].
     pub fn new(settings: BatchSettings) -> Result<Batch> {
         settings.options.validate()?;
         let params = &settings.options.params;
+        if !params.landmarks.is_empty() {
+            return Err(crate::Error::InvalidParameter {
+                name: "landmarks",
+                reason: format!(
+                    "{} given to a batch: landmarks name vertices of one pair; give them to \
+                     that pair's match instead",
+                    params.landmarks.len()
+                ),
+            });
+        }
         let job = PairJob {
             params,
             map: match settings.outputs {

@@ -37,9 +37,13 @@ pub const SC_REPAIR_WELD: u32 = 1;
 pub const SC_REPAIR_DEBRIS: u32 = 2;
 /// Repair flag: leave out far vertices and a point cloud's isolated points.
 pub const SC_REPAIR_OUTLIERS: u32 = 4;
+/// Repair flag: join a mesh's pieces that come close, for matching (no face is added;
+/// `Repairs::join_gap`).
+pub const SC_REPAIR_JOIN: u32 = 8;
 /// Every repair (what `sc_shape_new_mesh`, `sc_shape_new_point_cloud` and `sc_shape_read`
 /// make).
-pub const SC_REPAIR_ALL: u32 = SC_REPAIR_WELD | SC_REPAIR_DEBRIS | SC_REPAIR_OUTLIERS;
+pub const SC_REPAIR_ALL: u32 =
+    SC_REPAIR_WELD | SC_REPAIR_DEBRIS | SC_REPAIR_OUTLIERS | SC_REPAIR_JOIN;
 /// No repair: the shape is used as given.
 pub const SC_REPAIR_NONE: u32 = 0;
 
@@ -47,7 +51,7 @@ pub const SC_REPAIR_NONE: u32 = 0;
 fn repairs_of(flags: u32) -> Result<Repairs, Failure> {
     if flags & !SC_REPAIR_ALL != 0 {
         return Err(Failure::invalid(format!(
-            "repair flags {flags:#x}: only SC_REPAIR_WELD (1), SC_REPAIR_DEBRIS (2) and SC_REPAIR_OUTLIERS (4) exist"
+            "repair flags {flags:#x}: only SC_REPAIR_WELD (1), SC_REPAIR_DEBRIS (2), SC_REPAIR_OUTLIERS (4) and SC_REPAIR_JOIN (8) exist"
         )));
     }
     let default = Repairs::default();
@@ -60,6 +64,11 @@ fn repairs_of(flags: u32) -> Result<Repairs, Failure> {
         },
         debris_fraction: if on(SC_REPAIR_DEBRIS) {
             default.debris_fraction
+        } else {
+            0.0
+        },
+        join_gap: if on(SC_REPAIR_JOIN) {
+            default.join_gap
         } else {
             0.0
         },

@@ -37,21 +37,22 @@ pub enum HypothesisKind {
     /// term and the refinement decide).
     Symmetric,
     /// The answer with the matching of one symmetric group (its index among the groups with
-    /// a choice) replaced by another.
-    Alternative(usize),
+    /// a choice) replaced by another (its index among that group's options).
+    Alternative(usize, usize),
     /// The map the shapes' placement gives ([`crate::maps::placement::nearest_in_frame`]),
     /// no region constraint.
     Placement,
 }
 
 impl HypothesisKind {
-    /// A short name: `answer`, `mirror`, `symmetric`, `alternative N`.
+    /// A short name: `answer`, `mirror`, `symmetric`, `alternative G.O` (group G's option O),
+    /// `placement`.
     pub fn name(&self) -> String {
         match self {
             HypothesisKind::Answer => "answer".into(),
             HypothesisKind::Mirror => "mirror".into(),
             HypothesisKind::Symmetric => "symmetric".into(),
-            HypothesisKind::Alternative(g) => format!("alternative {g}"),
+            HypothesisKind::Alternative(g, o) => format!("alternative {g}.{o}"),
             HypothesisKind::Placement => "placement".into(),
         }
     }
@@ -301,7 +302,7 @@ pub fn candidates(
             pick[g] = Some(o);
             let groups = one_to_one_groups(&choices.assemble(&pick));
             if !out.iter().any(|(_, h)| *h == groups) {
-                out.push((HypothesisKind::Alternative(g), groups));
+                out.push((HypothesisKind::Alternative(g, o), groups));
             }
         }
     }

@@ -12,6 +12,7 @@ pub mod neighbors;
 pub mod proxy;
 pub mod repair;
 pub mod surface_point;
+mod warning;
 
 use std::collections::HashMap;
 
@@ -19,6 +20,7 @@ use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::io::RawShape;
 use crate::shape::neighbors::{symmetric_knn_graph, PointTree};
 pub use crate::shape::repair::Repairs;
+pub use crate::shape::warning::Warning;
 use crate::{Error, Result};
 
 /// Fewest usable vertices the pipeline accepts. The point-cloud Laplacian looks at
@@ -66,152 +68,14 @@ pub enum ShapeKind {
     PointCloud,
 }
 
-/// Something in the input that was repaired or ignored rather than rejected.
-#[derive(Debug, Clone, PartialEq, Eq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize),
-    serde(rename_all = "snake_case")
-)]
-pub enum Warning {
-    /// Faces with a repeated corner (zero area by construction) were dropped.
-    DegenerateFacesDropped {
-        /// Number of triangles dropped (counted after polygons are split).
-        count: usize,
-    },
-    /// Faces with the same three corners as an earlier face were dropped.
-    DuplicateFacesDropped {
-        /// Number of triangles dropped (counted after polygons are split).
-        count: usize,
-    },
-    /// Polygons with more than three corners were split into triangles.
-    PolygonsTriangulated {
-        /// Number of input faces with more than three corners.
-        count: usize,
-    },
-    /// Vertices used by no face; they take the values of the nearest used vertex.
-    UnreferencedVertices {
-        /// Number of input vertices used by no face.
-        count: usize,
-    },
-    /// The surface (or the point cloud's neighbour graph) has several connected pieces.
-    DisconnectedPieces {
-        /// Number of connected pieces (at least 2).
-        count: usize,
-    },
-    /// Edges shared by more than two faces (the Laplacian handles them).
-    NonManifoldEdges {
-        /// Number of edges shared by more than two faces.
-        count: usize,
-    },
-    /// Neighbouring faces with opposite orientation (the Laplacian does not depend on it; the
-    /// pointwise map uses [`Shape::oriented_triangles`]).
-    InconsistentOrientation {
-        /// Number of edges whose two faces run them in the same direction.
-        edges: usize,
-    },
-    /// Faces with (near) zero area but distinct corners; the Laplacian mollifies them.
-    NeedleOrZeroAreaFaces {
-        /// Number of triangles with area below 1e-8 times the mean triangle area.
-        count: usize,
-    },
-    /// Coincident vertices (UV seams, hard edges, triangle soups) were welded
-    /// ([`Repairs::weld_tolerance`]); each takes the values of the vertex it was welded to.
-    VerticesWelded {
-        /// Number of vertices welded into another one.
-        count: usize,
-    },
-    /// Small connected pieces (scan debris) were left out ([`Repairs::debris_fraction`]);
-    /// their vertices take the values of the nearest kept vertex.
-    SmallPiecesDropped {
-        /// Number of pieces left out.
-        pieces: usize,
-        /// Number of their vertices.
-        vertices: usize,
-    },
-    /// Vertices far from the rest of the shape were left out ([`Repairs::outliers`]), with
-    /// their faces; they take the values of the nearest kept vertex.
-    FarVerticesDropped {
-        /// Number of vertices left out.
-        count: usize,
-    },
-    /// Isolated points of a point cloud (local-density test) were left out of the
-    /// Laplacian and the area ([`Repairs::outliers`]); they take the values of the nearest
-    /// kept point.
-    OutlierPointsDropped {
-        /// Number of points left out.
-        count: usize,
-    },
-}
-
-impl Warning {
-    /// Whether it reports a repair ([`Repairs`]) rather than something merely noticed.
-    pub fn is_repair(&self) -> bool {
-        matches!(
-            self,
-            Warning::VerticesWelded { .. }
-                | Warning::SmallPiecesDropped { .. }
-                | Warning::FarVerticesDropped { .. }
-                | Warning::OutlierPointsDropped { .. }
-        )
-    }
-}
-
-impl std::fmt::Display for Warning {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Warning::DegenerateFacesDropped { count } => {
-                write!(f, "{count} degenerate faces (repeated corner) dropped")
-            }
-            Warning::DuplicateFacesDropped { count } => {
-                write!(f, "{count} duplicate faces dropped")
-            }
-            Warning::PolygonsTriangulated { count } => {
-                write!(f, "{count} polygons with more than 3 corners triangulated")
-            }
-            Warning::UnreferencedVertices { count } => write!(
-                f,
-                "{count} vertices are used by no face; they take the values of the nearest used vertex"
-            ),
-            Warning::DisconnectedPieces { count } => {
-                write!(f, "the shape has {count} disconnected pieces")
-            }
-            Warning::NonManifoldEdges { count } => {
-                write!(f, "{count} non-manifold edges (shared by more than two faces)")
-            }
-            Warning::InconsistentOrientation { edges } => write!(
-                f,
-                "{edges} edges join faces of opposite orientation (harmless for the Laplacian; re-oriented for the pointwise map)"
-            ),
-            Warning::NeedleOrZeroAreaFaces { count } => write!(
-                f,
-                "{count} faces have (near) zero area; the Laplacian mollifies them"
-            ),
-            Warning::VerticesWelded { count } => write!(
-                f,
-                "{count} coincident vertices welded (seams or an unwelded export); they share the answer of the vertex they were welded to"
-            ),
-            Warning::SmallPiecesDropped { pieces, vertices } => write!(
-                f,
-                "{pieces} small loose pieces ({vertices} vertices) left out as debris; they take the answer of the nearest kept vertex"
-            ),
-            Warning::FarVerticesDropped { count } => write!(
-                f,
-                "{count} vertices far from the rest of the shape left out; they take the answer of the nearest kept vertex"
-            ),
-            Warning::OutlierPointsDropped { count } => write!(
-                f,
-                "{count} isolated outlier points left out; they take the answer of the nearest kept point"
-            ),
-        }
-    }
-}
-
 /// A validated triangle mesh or point cloud, in the caller's vertex order.
 #[derive(Debug, Clone)]
 pub struct Shape {
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
+    /// Triangles that join nearby pieces of a mesh for the spectral stages
+    /// ([`Repairs::join_gap`]); not faces of the shape.
+    bridges: Vec<[u32; 3]>,
     kind: ShapeKind,
     /// Input vertices the computation runs on (all of them for a point cloud; those used by
     /// a face for a mesh), ascending.
@@ -351,6 +215,7 @@ impl Shape {
             triangles,
             active,
             welded_to,
+            bridges,
         } = match kind {
             ShapeKind::Mesh => {
                 Shape::repaired_mesh(&vertices, polygons, repairs, &mut warnings, cancel)?
@@ -377,6 +242,7 @@ impl Shape {
         let mut shape = Shape {
             vertices,
             triangles,
+            bridges,
             kind,
             active,
             representative,
@@ -485,8 +351,19 @@ impl Shape {
             }
         }
         cancel.check()?;
-        let keep =
-            repair::keep_large_pieces(vertices, &triangles, repairs.debris_fraction, cancel)?;
+        let mut bridges = if repairs.join_gap > 0.0 {
+            repair::bridges_between_pieces(vertices, &triangles, repairs.join_gap * size, cancel)?
+        } else {
+            Vec::new()
+        };
+        cancel.check()?;
+        let keep = repair::keep_large_pieces(
+            vertices,
+            &triangles,
+            &bridges,
+            repairs.debris_fraction,
+            cancel,
+        )?;
         cancel.check()?;
         if keep.iter().any(|&k| !k) {
             let before = used_by(&triangles).len();
@@ -512,6 +389,22 @@ impl Shape {
             });
         }
         let active = used_by(&triangles);
+        if !bridges.is_empty() {
+            let mut kept = vec![false; n];
+            for &v in &active {
+                kept[v as usize] = true;
+            }
+            bridges.retain(|t| t.iter().all(|&v| kept[v as usize]));
+            let before = count_pieces_of(n, &triangles, &[]);
+            let after = count_pieces_of(n, &triangles, &bridges);
+            if after < before {
+                warnings.push(Warning::PiecesJoined {
+                    pieces: before,
+                    into: after,
+                    bridges: bridges.len(),
+                });
+            }
+        }
         let unreferenced = n - referenced.len();
         if unreferenced > 0 {
             warnings.push(Warning::UnreferencedVertices {
@@ -522,6 +415,7 @@ impl Shape {
             triangles,
             active,
             welded_to,
+            bridges,
         })
     }
 
@@ -588,6 +482,7 @@ impl Shape {
             triangles: Vec::new(),
             active,
             welded_to,
+            bridges: Vec::new(),
         })
     }
 
@@ -634,7 +529,8 @@ impl Shape {
         &self.representative
     }
 
-    /// Number of connected pieces (of the surface, or of the point cloud's kNN graph).
+    /// Number of connected pieces (of the surface joined by its [`Shape::bridges`], or of
+    /// the point cloud's kNN graph).
     pub fn n_pieces(&self) -> usize {
         self.n_pieces
     }
@@ -731,6 +627,7 @@ impl Shape {
             ShapeKind::Mesh => self
                 .triangles
                 .iter()
+                .chain(&self.bridges)
                 .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
                 .map(|(a, b)| (a.min(b), a.max(b)))
                 .collect(),
@@ -758,6 +655,13 @@ impl Shape {
             ShapeKind::Mesh => Shape::mesh(vertices, &self.triangles),
             ShapeKind::PointCloud => Shape::point_cloud(vertices),
         }
+    }
+
+    /// Triangles that join nearby pieces of a mesh for the spectral stages (the Laplacian,
+    /// [`Shape::edges`]), made by [`Repairs::join_gap`]; they are not faces: transfers,
+    /// surface maps and orientation use [`Shape::triangles`] only.
+    pub fn bridges(&self) -> &[[u32; 3]] {
+        &self.bridges
     }
 
     /// The faces with one consistent orientation, each connected piece facing outward
@@ -899,7 +803,7 @@ impl Shape {
         match self.kind {
             // The triangles' sides join the same vertices as the sorted edges, with no sort.
             ShapeKind::Mesh => {
-                for (i, t) in self.triangles.iter().enumerate() {
+                for (i, t) in self.triangles.iter().chain(&self.bridges).enumerate() {
                     cancel.check_every(i)?;
                     sets.union(t[0] as usize, t[1] as usize);
                     sets.union(t[1] as usize, t[2] as usize);
@@ -931,6 +835,25 @@ struct Repaired {
     active: Vec<u32>,
     /// For every vertex, the vertex it was welded to (itself when none).
     welded_to: Vec<u32>,
+    /// Triangles joining nearby pieces ([`repair::bridges_between_pieces`]).
+    bridges: Vec<[u32; 3]>,
+}
+
+/// Connected pieces of the vertices used by `triangles` and `bridges`.
+fn count_pieces_of(n: usize, triangles: &[[u32; 3]], bridges: &[[u32; 3]]) -> usize {
+    let mut sets = DisjointSets::new(n);
+    let mut used = vec![false; n];
+    for t in triangles.iter().chain(bridges) {
+        sets.union(t[0] as usize, t[1] as usize);
+        sets.union(t[1] as usize, t[2] as usize);
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut roots: Vec<usize> = (0..n).filter(|&v| used[v]).map(|v| sets.find(v)).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots.len()
 }
 
 /// A face whose area is below this fraction of the mean face area counts as a needle.

@@ -18,10 +18,9 @@
 //!
 //! Matrices are indexed by the shape's *active* vertices ([`Shape::active_vertices`]).
 
-use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use sprs::{CsMat, TriMat};
 
-use crate::shape::neighbors::PointTree;
+use crate::shape::neighbors::{local_delaunay_around, PointTree};
 use crate::shape::{distance, Shape, ShapeKind};
 use crate::{Error, Result};
 
@@ -119,8 +118,9 @@ pub(crate) struct Triangulation {
     pub weight: f64,
 }
 
-/// The triangulation of a shape's active vertices: a mesh's own triangles, or a point
-/// cloud's local Delaunay triangles, with mollified edge lengths.
+/// The triangulation of a shape's active vertices: a mesh's own triangles and the bridges
+/// that join its pieces ([`Shape::bridges`]), or a point cloud's local Delaunay triangles,
+/// with mollified edge lengths.
 pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
     let positions: Vec<[f64; 3]> = shape
         .active_vertices()
@@ -136,6 +136,7 @@ pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
             let triangles: Vec<[u32; 3]> = shape
                 .triangles()
                 .iter()
+                .chain(shape.bridges())
                 .map(|t| t.map(|v| compact[v as usize]))
                 .collect();
             (triangles, 1.0)
@@ -251,59 +252,9 @@ pub(crate) fn heron_area(a: f64, b: f64, c: f64) -> f64 {
 pub fn local_delaunay_soup(points: &[[f64; 3]], k: usize) -> Vec<[u32; 3]> {
     let tree = PointTree::new(points);
     let mut soup = Vec::with_capacity(6 * points.len());
-    let mut planar = Vec::with_capacity(k + 1);
     for (i, p) in points.iter().enumerate() {
         let neighbors = tree.nearest_k(p, k + 1);
-        let Some((u, v)) = tangent_frame(points, &neighbors) else {
-            continue;
-        };
-        // The centre first, then the neighbours (excluding the centre and exact duplicates).
-        let mut ids = vec![i];
-        planar.clear();
-        planar.push(delaunator::Point { x: 0.0, y: 0.0 });
-        for &(j, d2) in &neighbors {
-            if j == i || d2 == 0.0 {
-                continue;
-            }
-            let d = crate::shape::sub(&points[j], p);
-            planar.push(delaunator::Point {
-                x: crate::shape::dot(&d, &u),
-                y: crate::shape::dot(&d, &v),
-            });
-            ids.push(j);
-        }
-        let triangulation = delaunator::triangulate(&planar);
-        for t in triangulation.triangles.chunks_exact(3) {
-            if t.contains(&0) {
-                soup.push([ids[t[0]] as u32, ids[t[1]] as u32, ids[t[2]] as u32]);
-            }
-        }
+        soup.extend(local_delaunay_around(points, i, &neighbors));
     }
     soup
-}
-
-/// Two orthonormal tangent directions at a point from the covariance of its neighbours
-/// (the normal is the direction of least variance). None when the neighbourhood is a point.
-fn tangent_frame(points: &[[f64; 3]], neighbors: &[(usize, f64)]) -> Option<([f64; 3], [f64; 3])> {
-    let n = neighbors.len() as f64;
-    let mut mean = Vector3::zeros();
-    for &(j, _) in neighbors {
-        mean += Vector3::from(points[j]);
-    }
-    mean /= n;
-    let mut covariance = Matrix3::zeros();
-    for &(j, _) in neighbors {
-        let d = Vector3::from(points[j]) - mean;
-        covariance += d * d.transpose();
-    }
-    let eigen = SymmetricEigen::new(covariance);
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
-    if !(eigen.eigenvalues[order[0]] > 0.0) {
-        return None;
-    }
-    let u = eigen.eigenvectors.column(order[0]).into_owned();
-    let normal = eigen.eigenvectors.column(order[2]).into_owned();
-    let v = normal.cross(&u).normalize();
-    Some(([u.x, u.y, u.z], [v.x, v.y, v.z]))
 }

@@ -45,6 +45,7 @@
 
 mod field;
 mod geom;
+mod pieces;
 mod polygonize;
 mod sampling;
 mod skeleton;
@@ -56,6 +57,7 @@ use std::fmt;
 use crate::{Error, Result};
 use geom::V3;
 
+pub use pieces::{cut_into_pieces, PiecesMesh};
 pub use sampling::{sample_points, SampledCloud};
 
 /// The kinds of figure.

@@ -6,7 +6,8 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use shapecorr::collection::{
-    map_file, BasisCache, BatchSettings, OutputFolder, Outputs, Reading, DEFAULT_MEMORY_BYTES,
+    map_file, BasisCache, Batch, BatchSettings, OutputFolder, Outputs, Reading,
+    DEFAULT_MEMORY_BYTES,
 };
 use shapecorr::options::Options;
 use shapecorr::spectral::eigen::EigenParams;
@@ -178,5 +179,18 @@ fn an_output_folder_is_held_by_one_run_with_one_set_of_settings() {
     std::fs::write(out.join("batch.json"), r#"{"outputs":"regions"}"#).unwrap();
     let e = OutputFolder::open(&out, &settings(8, &dir.join("c1"))).unwrap_err();
     assert!(e.to_string().contains("earlier version"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_batch_refuses_landmarks_which_name_vertices_of_one_pair() {
+    let dir = scratch("landmarks");
+    let mut with_landmarks = settings(8, &dir.join("c"));
+    with_landmarks.options.params.landmarks = vec![[0, 0], [5, 7]];
+    let Err(e) = Batch::new(with_landmarks) else {
+        panic!("landmarks accepted by a batch")
+    };
+    assert!(e.to_string().contains("landmarks"), "{e}");
+    assert!(Batch::new(settings(8, &dir.join("c"))).is_ok());
     let _ = std::fs::remove_dir_all(&dir);
 }

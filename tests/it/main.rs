@@ -17,6 +17,7 @@ mod io_files;
 mod limits;
 mod matching;
 mod multiresolution;
+mod pieces;
 mod point_cloud;
 mod pointwise;
 mod repairs;

@@ -322,8 +322,9 @@ class Shape(_Handle):
         indices (copied; float32 coordinates stay float32 on the way in).
 
         ``repair``: ``True`` (the default) welds coincident vertices (UV seams, triangle
-        soups) and leaves out small loose pieces and far vertices; ``False`` uses the mesh as
-        given; or a collection of ``"weld"``, ``"debris"``, ``"outliers"``. Every vertex
+        soups), joins pieces that come close for matching (no face is added) and leaves out
+        small loose pieces and far vertices; ``False`` uses the mesh as given; or a
+        collection of ``"weld"``, ``"debris"``, ``"outliers"``, ``"join"``. Every vertex
         keeps its index; the repairs made are in :attr:`warnings`."""
         vertices = np.asarray(vertices)
         flags = _repair_flags(repair)
@@ -486,8 +487,8 @@ def _lines(function, shape):
 
 
 #: The repairs by name (the C API's ``SC_REPAIR_*`` flags).
-REPAIRS: dict[str, int] = {"weld": 1, "debris": 2, "outliers": 4}
-_REPAIR_ALL = 7
+REPAIRS: dict[str, int] = {"weld": 1, "debris": 2, "outliers": 4, "join": 8}
+_REPAIR_ALL = 15
 
 
 def _repair_flags(repair):
@@ -790,7 +791,7 @@ class Hypothesis(NamedTuple):
     """A verified hypothesis of a result (:attr:`Correspondence.runner_up`,
     :attr:`Correspondence.chosen`): its name, cost and the turn its map implies."""
 
-    #: ``"answer"``, ``"mirror"``, ``"symmetric"``, ``"alternative N"`` or ``"placement"``.
+    #: ``"answer"``, ``"mirror"``, ``"symmetric"``, ``"alternative G.O"`` or ``"placement"``.
     hypothesis: str
     #: The cost the hypotheses are ranked by (lower is better).
     cost: float
@@ -826,7 +827,7 @@ class _Verdict:
     @property
     def hypothesis(self) -> str | None:
         """The chosen hypothesis's name (``"answer"``, ``"mirror"``, ``"symmetric"``,
-        ``"alternative N"``, ``"placement"``), or None when the answer was not verified."""
+        ``"alternative G.O"``, ``"placement"``), or None when the answer was not verified."""
         chosen = self.chosen
         return None if chosen is None else chosen.hypothesis
 
