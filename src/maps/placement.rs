@@ -74,6 +74,15 @@ pub const FAR_TURN: f64 = 100.0;
 /// FAUST_r pairs, all wrong at a ratio of 1.5 or more).
 pub const PLACEMENT_COST_RATIO: f64 = 1.35;
 
+/// When every region answer implies at least [`FAR_TURN`] and the frame's own map at most
+/// [`NEAR_TURN`], [`Placement::Auto`] takes the frame's map if it costs at most this many
+/// times the cheapest answer: the region stage has half-turned every answer (seen on
+/// figures modelled in pieces, where the frame's map cost 2.0-2.9 times the cheapest and was
+/// right, docs/decisions.md, "Shapes in pieces"). On the development pairs in their own
+/// frames this happened once, at 7.9 times, with a right region answer; with B turned at
+/// random the frame's map cost at least RANDOM_TURN_MIN_RATIO times (docs/placement.md).
+pub const FRAME_ONLY_COST_RATIO: f64 = 3.5;
+
 /// The proper rotation `R` that best sends `from` onto `to` (`to[i] ~ R from[i] + t`, least
 /// squares; Kabsch's method), as rows.
 pub fn best_rotation(from: &[[f64; 3]], to: &[[f64; 3]]) -> [[f64; 3]; 3] {
@@ -138,7 +147,8 @@ pub struct FrameView<'a> {
 /// cheapest region hypothesis (the frame's own only when no region hypothesis is there: on
 /// FAUST its refined map was up to 0.026 less accurate than the region answer of the same
 /// turn, docs/placement.md), provided every other hypothesis whose map differs implies at
-/// most [`NEAR_TURN`] or at least [`FAR_TURN`]. `Trust`: among the eligible hypotheses
+/// most [`NEAR_TURN`] or at least [`FAR_TURN`]; with none within [`NEAR_TURN`], the frame's
+/// own map as [`FRAME_ONLY_COST_RATIO`] says. `Trust`: among the eligible hypotheses
 /// within the cost ratio, the cheapest within [`NEAR_TURN`] of the least turn. `Ignore`:
 /// none.
 pub fn frame_pick(mode: Placement, view: &FrameView<'_>) -> Option<usize> {
@@ -169,8 +179,17 @@ pub fn frame_pick(mode: Placement, view: &FrameView<'_>) -> Option<usize> {
         }
         Placement::Auto => {
             let near = |h: usize| competitive(h) && turns[h] <= NEAR_TURN;
-            let pick =
-                cheapest_of(&|h| near(h) && !from_frame(h)).or_else(|| cheapest_of(&near))?;
+            let Some(pick) =
+                cheapest_of(&|h| near(h) && !from_frame(h)).or_else(|| cheapest_of(&near))
+            else {
+                // Every region answer half-turned, the frame's map not: the frame's map.
+                let own = (0..n).find(|&h| eligible(h) && from_frame(h))?;
+                let region_far = (0..n)
+                    .filter(|&h| eligible(h) && !from_frame(h))
+                    .all(|h| turns[h] >= FAR_TURN);
+                let affordable = costs[own] <= FRAME_ONLY_COST_RATIO * cheapest;
+                return (region_far && turns[own] <= NEAR_TURN && affordable).then_some(own);
+            };
             let undecided = (0..n).any(|h| {
                 !from_frame(h) && different(h, pick) && turns[h] > NEAR_TURN && turns[h] < FAR_TURN
             });

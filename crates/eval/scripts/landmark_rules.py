@@ -14,7 +14,7 @@ import sys
 from placement_rules import decide, pairs, summary
 
 # The library's rule: LANDMARK_TOLERANCE, LANDMARK_COST_CAP (src/maps/hypotheses.rs).
-RULE = (0.05, None)
+RULE = (0.1, None)
 
 
 def landmark_pick(hs, start, rule):
