@@ -579,7 +579,7 @@ pub const OPTIONS: &[OptionInfo] = &[
         "low-poly meshes: one with fewer vertices runs on a refined copy of at least this many (0: never)",
         field!(Params, Int, multiresolution.refine_below),
     )
-    .range(0.0, 1_000_000.0),
+    .range(0.0, 100_000.0),
     regions(
         "max_vertices",
         "largest shape accepted, in vertices; a larger one is refused before any work",

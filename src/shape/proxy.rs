@@ -163,6 +163,12 @@ impl Proxy {
     /// the same, so every input vertex is exactly a proxy vertex and every proxy vertex lies
     /// on an input triangle. A point cloud gives [`crate::Error::InvalidParameter`].
     pub fn refine(shape: &Shape, at_least: usize) -> Result<Proxy> {
+        Proxy::refine_cancellable(shape, at_least, &Cancel::default())
+    }
+
+    /// [`Proxy::refine`], stopping with [`crate::Error::Cancelled`] soon after `cancel` is
+    /// set (looked at every [`LOCATE_BLOCK`] triangles).
+    pub fn refine_cancellable(shape: &Shape, at_least: usize, cancel: &Cancel) -> Result<Proxy> {
         if shape.kind() != ShapeKind::Mesh {
             return Err(crate::Error::InvalidParameter {
                 name: "refine_below",
@@ -177,7 +183,10 @@ impl Proxy {
         loop {
             let mut midpoint = std::collections::HashMap::with_capacity(triangles.len() * 3 / 2);
             let mut split = Vec::with_capacity(triangles.len() * 4);
-            for &[a, b, c] in &triangles {
+            for (f, &[a, b, c]) in triangles.iter().enumerate() {
+                if f % LOCATE_BLOCK == 0 {
+                    cancel.check()?;
+                }
                 let mut mid = |p: u32, q: u32| -> u32 {
                     *midpoint.entry((p.min(q), p.max(q))).or_insert_with(|| {
                         let (x, y) = (vertices[p as usize], vertices[q as usize]);
@@ -198,7 +207,7 @@ impl Proxy {
         let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
         // Midpoint subdivision keeps a low-poly mesh's long thin triangles; their intrinsic
         // Delaunay flips give the Laplacian non-negative weights (docs/decisions.md,
-        // "Low-poly meshes": 300-vertex pairs 0.067 -> 0.025).
+        // "Low-poly meshes: a refined working mesh": 300-vertex pairs 0.067 -> 0.025).
         let refined =
             Shape::mesh_with(vertices, &polygons, &Repairs::none())?.with_intrinsic_delaunay();
         let representative = shape.representative();
@@ -357,7 +366,8 @@ fn simplified_in_pieces(
     Ok(indices)
 }
 
-/// Input vertices located per block between two looks at the cancel flag.
+/// Input vertices located (or triangles refined) per block between two looks at the cancel
+/// flag.
 const LOCATE_BLOCK: usize = 16_384;
 
 /// Where every input vertex of `shape` lies on `proxy` (an inactive vertex where its

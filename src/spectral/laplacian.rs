@@ -148,7 +148,16 @@ pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
     let mut triangles = triangles;
     let mut lengths = mollified_edge_lengths(&positions, &triangles);
     if shape.intrinsic_delaunay() {
+        // Flipped at about unit size (a power of two: exact), as the Laplacian is built.
+        let longest = lengths.iter().flatten().fold(0.0f64, |m, l| m.max(*l));
+        let scale = crate::shape::power_of_two_near(longest);
+        for l in lengths.iter_mut().flatten() {
+            *l /= scale;
+        }
         flip_to_intrinsic_delaunay(&mut triangles, &mut lengths);
+        for l in lengths.iter_mut().flatten() {
+            *l *= scale;
+        }
     }
     Triangulation {
         positions,

@@ -1,6 +1,6 @@
-//! Low-poly meshes on a refined working mesh (docs/decisions.md, "Low-poly meshes"): pairs of
-//! generated figures in two poses (humanoid and quadruped, 5K vertices), each pose decimated
-//! on its own by meshoptimizer ([`synth::decimate`]) to 150, 300 and 1,000 vertices, mapped
+//! Low-poly meshes on a refined working mesh (docs/decisions.md, "Low-poly meshes: a
+//! refined working mesh"): pairs of generated figures in two poses (humanoid and
+//! quadruped, 5K vertices), each pose decimated on its own by meshoptimizer ([`synth::decimate`]) to 150, 300 and 1,000 vertices, mapped
 //! with `refine_below` off and at each value given, and scored on the 5K figure by index
 //! (mean geodesic error over sqrt(area), a left/right flip allowed, a pair failed above 0.05).
 //! Prints per size and setting the mean, median and worst pair, the failed pairs and the
@@ -8,7 +8,9 @@
 //! (every vertex of B to the vertex of A nearest its truth), which no map to A's vertices
 //! beats. `--sizes 150,300` scores those sizes only (5000: the original).
 //!
-//!     cargo run --release -p shapecorr-eval --example low_poly -- [--sizes N,..] [REFINE_BELOW ...]
+//!     cargo run --release -p shapecorr-eval --example low_poly -- [--sizes N,..] [N ...]
+//!
+//! (each N a `refine_below` to compare with 0; the default's when none is given)
 
 use std::time::Instant;
 
