@@ -64,8 +64,10 @@ fn a_refined_copy_keeps_every_input_vertex_and_the_surface() {
             assert_eq!(proxy.input_vertex(w as u32), w as u32);
         }
     }
-    let mut cloud = Multiresolution::default();
-    cloud.refine_below = 1_000_000;
+    let cloud = Multiresolution {
+        refine_below: 100_000,
+        ..Default::default()
+    };
     let points = Shape::point_cloud(low.vertices.clone()).unwrap();
     assert!(
         !cloud.applies_to(&points),
