@@ -575,6 +575,12 @@ pub const OPTIONS: &[OptionInfo] = &[
     )
     .range(64.0, 100_000_000.0),
     regions(
+        "refine_below",
+        "low-poly meshes: one with fewer vertices runs on a refined copy of at least this many (0: never)",
+        field!(Params, Int, multiresolution.refine_below),
+    )
+    .range(0.0, 100_000.0),
+    regions(
         "max_vertices",
         "largest shape accepted, in vertices; a larger one is refused before any work",
         field!(Params, Int, eigen.max_vertices),

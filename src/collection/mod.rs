@@ -36,7 +36,7 @@ pub use pairs::{parse_pairs, read_pairs, PairLine};
 use crate::options::Options;
 use crate::pipeline::multiresolution::working;
 use crate::pipeline::{run_pair, PairJob, PairShapes, ReadyShape};
-use crate::shape::proxy::Proxy;
+use crate::shape::proxy::{Proxy, ProxyKind};
 use crate::spectral::eigen::{EigenParams, Eigenbasis};
 use crate::{Error, NoProgress, ReadAs, Repairs, Result, Shape};
 
@@ -311,15 +311,18 @@ impl Batch {
         let proxy = multiresolution.proxy(&shape)?;
         let working = working(&shape, &proxy);
         record.working_vertices = working.n_vertices();
-        let reading = format!(
-            "{:?}|proxy={}",
-            self.settings.reading,
-            if proxy.is_some() {
-                multiresolution.proxy_vertices
-            } else {
-                0
-            }
-        );
+        // The working shape's recipe: its basis in the cache is that shape's.
+        let reading = match proxy.as_ref().map(|p| p.kind) {
+            None => format!("{:?}|proxy=0", self.settings.reading),
+            Some(ProxyKind::Simplified) => format!(
+                "{:?}|proxy={}",
+                self.settings.reading, multiresolution.proxy_vertices
+            ),
+            Some(ProxyKind::Refined) => format!(
+                "{:?}|refined={}",
+                self.settings.reading, multiresolution.refine_below
+            ),
+        };
         record.key = BasisCache::file_key(path, &reading, &self.eigen)?;
         let timed = self
             .cache

@@ -598,6 +598,10 @@ mod tests {
                 ruled_out: vec![false; 2],
             }),
             estimate: None,
+            working: [crate::pipeline::multiresolution::Working {
+                kind: crate::pipeline::multiresolution::WorkingKind::Input,
+                vertices: 0,
+            }; 2],
         });
         std::sync::Arc::into_raw(std::sync::Arc::new(correspondence))
     }

@@ -15,6 +15,7 @@ use crate::colors::region_colors;
 use crate::geodesic::region_distance_matrix;
 use crate::maps::hypotheses::Verdict;
 use crate::pipeline::budget::Estimate;
+use crate::pipeline::multiresolution::Working;
 use crate::pipeline::pair::{run_pair, PairJob, PairShapes};
 use crate::pipeline::params::{HksFallback, Params};
 use crate::pipeline::pointwise::verify_regions;
@@ -45,8 +46,9 @@ pub struct Timings {
     pub matching: f64,
     /// Symmetry breaking into the one-to-one matches, their verification included.
     pub one_to_one: f64,
-    /// Building the proxies of dense shapes and bringing the answers back to every input
-    /// vertex (0 when both shapes ran at full resolution, [`Params::multiresolution`]).
+    /// Building the proxies of dense shapes (or refined copies of low-poly meshes) and
+    /// bringing the answers back to every input vertex (0 when both shapes ran as they are,
+    /// [`Params::multiresolution`]).
     pub proxies: f64,
     /// Whole call, from [`Correspondence::compute`] or [`Correspondence::from_bases`].
     pub total: f64,
@@ -75,6 +77,9 @@ pub struct Correspondence {
     /// What the job was estimated to take before it started (None from
     /// [`Correspondence::from_bases`], which the budget does not see).
     pub estimate: Option<Estimate>,
+    /// What the pipeline ran on for A and B: the input, a proxy or a refined copy
+    /// ([`Params::multiresolution`]).
+    pub working: [Working; 2],
 }
 
 impl Correspondence {
@@ -154,6 +159,7 @@ impl Correspondence {
             timings,
             verdict: None,
             estimate: None,
+            working: [side_a.shape, side_b.shape].map(|s| Working::of(s, None)),
         };
         if params.verify_hypotheses && !params.skip_one_to_one {
             verify_regions(side_a, side_b, &mut result, &params.guidance(), progress)?;

@@ -1,14 +1,18 @@
-//! The multiresolution path for dense shapes (docs/design.md, step 16).
+//! The multiresolution path for dense and low-poly shapes (docs/design.md, step 16).
 //!
 //! Above [`Multiresolution::above`] active vertices a shape is replaced by a proxy of about
-//! [`Multiresolution::proxy_vertices`] vertices ([`Proxy`]); the whole pipeline runs on the
-//! proxies and its answers come back to every input vertex:
+//! [`Multiresolution::proxy_vertices`] vertices ([`Proxy::build`]); below
+//! [`Multiresolution::refine_below`] a mesh by a refined copy of the same surface of at least
+//! that many ([`Proxy::refine`]: every input vertex is one of its vertices). The whole
+//! pipeline runs on the working shapes and its answers come back to every input vertex:
 //! - regions: every input vertex takes the region of its nearest proxy vertex on the proxy
 //!   surface ([`Proxy::lift_nearest`]);
 //! - the map: every input vertex of B is located on B's proxy, its three proxy vertices are
 //!   mapped to A's proxy, and where their images lie close together the point they span
 //!   with the same weights is taken to its nearest input vertex of A (a 3D k-d tree); where
 //!   they do not (the map tears there), the image of the heaviest is kept ([`lift_map`]).
+//!   An image on A's refined copy is the input vertex of A nearest on the input triangle it
+//!   lies on (its heaviest corner, [`Proxy::input_vertex`]).
 //!
 //! Nothing compares full-resolution vertex sets pairwise: building a proxy and lifting are
 //! O(n log n) in the input's vertices, the rest runs on the proxies.
@@ -18,7 +22,8 @@ use rayon::prelude::*;
 use crate::pipeline::correspondence::Correspondence;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::neighbors::PointTree;
-use crate::shape::proxy::Proxy;
+use crate::shape::proxy::{Proxy, ProxyKind};
+use crate::shape::ShapeKind;
 use crate::shape::{distance, Shape};
 use crate::spectral::eigen::{check_max_vertices, EigenParams};
 use crate::Result;
@@ -30,6 +35,10 @@ pub struct Multiresolution {
     pub above: usize,
     /// About how many vertices a proxy has.
     pub proxy_vertices: usize,
+    /// A mesh with fewer active vertices than this runs on a refined copy of at least this
+    /// many ([`Proxy::refine`]; 0: never). Point clouds are left as they are, and a shape
+    /// above [`Multiresolution::above`] gets a proxy whatever this is.
+    pub refine_below: usize,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -44,11 +53,64 @@ pub const DEFAULT_PROXY_ABOVE: usize = 12_000;
 /// the full-resolution pipeline was measured (docs/results.md).
 pub const DEFAULT_PROXY_VERTICES: usize = 8_000;
 
+/// Default [`Multiresolution::refine_below`], chosen on generated figures decimated to 150,
+/// 300 and 1,000 vertices (docs/decisions.md, "Low-poly meshes: a refined working mesh"):
+/// 300 vertices refined to 4.8K failed 0 of 6 pairs (to 1.2K: 1 of 6, as they are: 4 of 6),
+/// and a larger threshold only made the smallest meshes larger and slower (150 vertices
+/// refined to 9.6K: 4 of 6 failed). FAUST (6.9K), TOSCA and the 5K figures are above it and run as before.
+pub const DEFAULT_REFINE_BELOW: usize = 2_000;
+
+/// The working shape of one input shape, as results report it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Working {
+    /// What the pipeline ran on.
+    pub kind: WorkingKind,
+    /// Its active vertices.
+    pub vertices: usize,
+}
+
+/// What the pipeline ran on for one input shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize),
+    serde(rename_all = "snake_case")
+)]
+pub enum WorkingKind {
+    /// The input shape itself.
+    Input,
+    /// A simplified proxy of a dense shape ([`Proxy::build`]).
+    Proxy,
+    /// A refined copy of a low-poly mesh ([`Proxy::refine`]).
+    Refined,
+}
+
+impl Working {
+    /// The working shape of `shape` with its proxy, if any.
+    pub fn of(shape: &Shape, proxy: Option<&Proxy>) -> Working {
+        match proxy {
+            None => Working {
+                kind: WorkingKind::Input,
+                vertices: shape.active_vertices().len(),
+            },
+            Some(p) => Working {
+                kind: match p.kind {
+                    ProxyKind::Simplified => WorkingKind::Proxy,
+                    ProxyKind::Refined => WorkingKind::Refined,
+                },
+                vertices: p.shape.active_vertices().len(),
+            },
+        }
+    }
+}
+
 impl Default for Multiresolution {
     fn default() -> Self {
         Multiresolution {
             above: DEFAULT_PROXY_ABOVE,
             proxy_vertices: DEFAULT_PROXY_VERTICES,
+            refine_below: DEFAULT_REFINE_BELOW,
             non_exhaustive: crate::NonExhaustive(()),
         }
     }
@@ -74,18 +136,38 @@ impl Multiresolution {
         self.working_size_of(shape.active_vertices().len())
     }
 
-    /// The vertices a shape of `n` active vertices is computed on.
+    /// The vertices a shape of `n` active vertices is computed on (a refined mesh's
+    /// estimated: a closed mesh has about three edges per vertex, so a subdivision
+    /// quadruples it).
     pub fn working_size_of(&self, n: usize) -> usize {
         if self.above != 0 && n > self.above {
             n.min(self.proxy_vertices)
+        } else if n > 0 && n < self.refine_below {
+            let mut refined = 4 * n;
+            while refined < self.refine_below {
+                refined *= 4;
+            }
+            refined
         } else {
             n
         }
     }
 
-    /// Whether `shape` gets a proxy.
+    /// Whether `shape` runs on a proxy (simplified or refined).
     pub fn applies_to(&self, shape: &Shape) -> bool {
-        self.above != 0 && shape.active_vertices().len() > self.above
+        self.kind_for(shape).is_some()
+    }
+
+    /// The proxy `shape` gets, if any.
+    pub fn kind_for(&self, shape: &Shape) -> Option<ProxyKind> {
+        let n = shape.active_vertices().len();
+        if self.above != 0 && n > self.above {
+            Some(ProxyKind::Simplified)
+        } else if n < self.refine_below && shape.kind() == ShapeKind::Mesh {
+            Some(ProxyKind::Refined)
+        } else {
+            None
+        }
     }
 
     /// The proxies of the shapes that need one (None for a shape that runs as it is).
@@ -103,10 +185,14 @@ impl Multiresolution {
         polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
             let build = |shape: &Shape| -> Result<Option<Proxy>> {
                 cancel.check()?;
-                if self.applies_to(shape) {
-                    Proxy::build_cancellable(shape, self.proxy_vertices, cancel).map(Some)
-                } else {
-                    Ok(None)
+                match self.kind_for(shape) {
+                    Some(ProxyKind::Simplified) => {
+                        Proxy::build_cancellable(shape, self.proxy_vertices, cancel).map(Some)
+                    }
+                    Some(ProxyKind::Refined) => {
+                        Proxy::refine_cancellable(shape, self.refine_below, cancel).map(Some)
+                    }
+                    None => Ok(None),
                 }
             };
             let proxy_a = build(a).map_err(|e| e.in_shape('A'))?;
@@ -120,10 +206,10 @@ impl Multiresolution {
 impl Multiresolution {
     /// The proxy of `shape` when it needs one.
     pub(crate) fn proxy(&self, shape: &Shape) -> Result<Option<Proxy>> {
-        if self.applies_to(shape) {
-            Proxy::build(shape, self.proxy_vertices).map(Some)
-        } else {
-            Ok(None)
+        match self.kind_for(shape) {
+            Some(ProxyKind::Simplified) => Proxy::build(shape, self.proxy_vertices).map(Some),
+            Some(ProxyKind::Refined) => Proxy::refine(shape, self.refine_below).map(Some),
+            None => Ok(None),
         }
     }
 }
@@ -179,7 +265,7 @@ fn lift_map_polling(
 ) -> Result<Vec<u32>> {
     let working_a = proxy_a.map_or(a, |p| &p.shape);
     // A proxy vertex of A as an input vertex of A.
-    let input_a = |v: u32| proxy_a.map_or(v, |p| p.input_vertex[v as usize]);
+    let input_a = |v: u32| proxy_a.map_or(v, |p| p.input_vertex(v));
     let active_a = a.active_vertices();
     let tree = PointTree::new(
         &active_a

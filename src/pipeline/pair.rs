@@ -11,7 +11,7 @@ use crate::maps::landmarks::check_landmarks;
 use crate::maps::pointwise::{pin_landmarks, PointwiseMap, PointwiseParams, Refinement};
 use crate::pipeline::budget::{regions_job, Estimate, Job};
 use crate::pipeline::correspondence::Correspondence;
-use crate::pipeline::multiresolution::{lift_map, lift_regions, working};
+use crate::pipeline::multiresolution::{lift_map, lift_regions, working, Working};
 use crate::pipeline::pointwise::{basis_params, regions_and_map};
 use crate::pipeline::Params;
 use crate::progress::Progress;
@@ -290,6 +290,7 @@ fn on_ready(
     };
     let t = Instant::now();
     lift_regions(&mut regions, [a.proxy, b.proxy]);
+    regions.working = [Working::of(a.shape, a.proxy), Working::of(b.shape, b.proxy)];
     if let Some(map) = &mut map {
         let lift = |p2p: &[u32], progress: &mut dyn Progress| {
             lift_map((a.shape, a.proxy), (b.shape, b.proxy), p2p, progress)

@@ -86,6 +86,9 @@ pub struct Shape {
     warnings: Vec<Warning>,
     /// [`Shape::fingerprint`], computed on first use.
     fingerprint: std::sync::OnceLock<u64>,
+    /// Whether its Laplacian is built on the intrinsic Delaunay triangulation of its
+    /// triangles ([`Shape::intrinsic_delaunay`]).
+    intrinsic_delaunay: bool,
 }
 
 impl Shape {
@@ -249,6 +252,7 @@ impl Shape {
             n_pieces: 0,
             warnings,
             fingerprint: std::sync::OnceLock::new(),
+            intrinsic_delaunay: false,
         };
         match kind {
             ShapeKind::Mesh => {
@@ -506,6 +510,19 @@ impl Shape {
             }
         }
         around
+    }
+
+    /// Whether its Laplacian (and its heat geodesics) are built on the intrinsic Delaunay
+    /// triangulation of its triangles (a refined low-poly mesh's,
+    /// [`crate::shape::proxy::Proxy::refine`]), not on the triangles as they are.
+    pub fn intrinsic_delaunay(&self) -> bool {
+        self.intrinsic_delaunay
+    }
+
+    /// The same shape, its Laplacian built on the intrinsic Delaunay triangulation.
+    pub(crate) fn with_intrinsic_delaunay(mut self) -> Shape {
+        self.intrinsic_delaunay = self.kind == ShapeKind::Mesh;
+        self
     }
 
     /// Mesh or point cloud.

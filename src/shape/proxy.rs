@@ -1,5 +1,7 @@
-//! Coarse proxies of dense shapes (docs/design.md, step 16): the pipeline runs on a
-//! proxy of a few thousand vertices and its answers come back to every input vertex.
+//! Working meshes that stand for an input shape (docs/design.md, step 16): the pipeline runs
+//! on a proxy of a few thousand vertices and its answers come back to every input vertex. A
+//! dense shape gets a coarser proxy ([`Proxy::build`]); a low-poly mesh a refined copy of
+//! the same surface ([`Proxy::refine`]).
 //!
 //! A mesh is simplified by meshoptimizer's edge collapse (`meshopt::simplify`, quadric
 //! error, regularised triangles: the Laplacian wants well-shaped triangles more than an exact
@@ -20,15 +22,29 @@ use crate::shape::surface_point::{
 use crate::shape::{Repairs, Shape, ShapeKind};
 use crate::Result;
 
-/// A simplified shape and where every input vertex lies on it.
+/// A working shape that stands for an input shape, and where each lies on the other.
 #[derive(Debug, Clone)]
 pub struct Proxy {
-    /// The simplified shape the pipeline runs on.
+    /// How it was made from the input.
+    pub kind: ProxyKind,
+    /// The shape the pipeline runs on.
     pub shape: Shape,
-    /// For every proxy vertex, the input vertex it is (ascending).
-    pub input_vertex: Vec<u32>,
-    /// For every input vertex, where it lies on the proxy.
+    /// For every proxy vertex, where it lies on the input surface: the input vertex it is
+    /// (weight 1) on a simplified proxy; on a refined one, an input triangle's corners and
+    /// barycentric weights (an input vertex keeps weight 1).
+    pub origin: Vec<SurfacePoint>,
+    /// For every input vertex, where it lies on the proxy (on a refined proxy, exactly the
+    /// proxy vertex it is).
     pub location: Vec<SurfacePoint>,
+}
+
+/// How a proxy was made from its input shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProxyKind {
+    /// A subset of the input vertices (meshoptimizer's simplification): a dense shape.
+    Simplified,
+    /// Every input vertex and triangle's midpoints (midpoint subdivision): a low-poly mesh.
+    Refined,
 }
 
 /// Proxy candidates checked per input vertex: the triangles around its nearest proxy
@@ -110,10 +126,17 @@ impl Proxy {
         cancel.check()?;
         let location = locate(shape, &proxy_shape, cancel)?;
         Ok(Proxy {
+            kind: ProxyKind::Simplified,
             shape: proxy_shape,
-            input_vertex: kept,
+            origin: kept.into_iter().map(SurfacePoint::at).collect(),
             location,
         })
+    }
+
+    /// The input vertex that stands for proxy vertex `w`: the one it is, or the heaviest
+    /// corner of the input triangle it lies on.
+    pub fn input_vertex(&self, w: u32) -> u32 {
+        self.origin[w as usize].nearest()
     }
 
     /// A per-vertex value of the proxy taken by every input vertex from its nearest proxy
@@ -125,6 +148,106 @@ impl Proxy {
             .map(|p| proxy_values[p.nearest() as usize])
             .collect()
     }
+}
+
+/// How many vertices a mesh of `active` active vertices and `edges` edges has after one
+/// midpoint subdivision: one more per edge.
+pub fn refined_size(active: usize, edges: usize) -> usize {
+    active + edges
+}
+
+impl Proxy {
+    /// A refined copy of mesh `shape`: every triangle split into four at its edges'
+    /// midpoints, repeated until the copy has at least `at_least` active vertices (and at
+    /// least once). The input's vertices keep their indices and positions and the surface is
+    /// the same, so every input vertex is exactly a proxy vertex and every proxy vertex lies
+    /// on an input triangle. A point cloud gives [`crate::Error::InvalidParameter`].
+    pub fn refine(shape: &Shape, at_least: usize) -> Result<Proxy> {
+        Proxy::refine_cancellable(shape, at_least, &Cancel::default())
+    }
+
+    /// [`Proxy::refine`], stopping with [`crate::Error::Cancelled`] soon after `cancel` is
+    /// set (looked at every [`LOCATE_BLOCK`] triangles).
+    pub fn refine_cancellable(shape: &Shape, at_least: usize, cancel: &Cancel) -> Result<Proxy> {
+        if shape.kind() != ShapeKind::Mesh {
+            return Err(crate::Error::InvalidParameter {
+                name: "refine_below",
+                reason: "a point cloud has no triangles to refine".into(),
+            });
+        }
+        let mut vertices = shape.vertices().to_vec();
+        let mut origin: Vec<SurfacePoint> =
+            (0..vertices.len() as u32).map(SurfacePoint::at).collect();
+        let mut triangles = shape.triangles().to_vec();
+        let mut active = shape.active_vertices().len();
+        loop {
+            let mut midpoint = std::collections::HashMap::with_capacity(triangles.len() * 3 / 2);
+            let mut split = Vec::with_capacity(triangles.len() * 4);
+            for (f, &[a, b, c]) in triangles.iter().enumerate() {
+                if f % LOCATE_BLOCK == 0 {
+                    cancel.check()?;
+                }
+                let mut mid = |p: u32, q: u32| -> u32 {
+                    *midpoint.entry((p.min(q), p.max(q))).or_insert_with(|| {
+                        let (x, y) = (vertices[p as usize], vertices[q as usize]);
+                        vertices.push([0, 1, 2].map(|i| 0.5 * (x[i] + y[i])));
+                        origin.push(halfway(&origin[p as usize], &origin[q as usize]));
+                        (vertices.len() - 1) as u32
+                    })
+                };
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                split.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+            }
+            active = refined_size(active, midpoint.len());
+            triangles = split;
+            if active >= at_least || midpoint.is_empty() {
+                break;
+            }
+        }
+        let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+        // Midpoint subdivision keeps a low-poly mesh's long thin triangles; their intrinsic
+        // Delaunay flips give the Laplacian non-negative weights (docs/decisions.md,
+        // "Low-poly meshes: a refined working mesh": 300-vertex pairs 0.067 -> 0.025).
+        let refined =
+            Shape::mesh_with(vertices, &polygons, &Repairs::none())?.with_intrinsic_delaunay();
+        let representative = shape.representative();
+        let location = (0..shape.n_vertices())
+            .map(|v| SurfacePoint::at(representative[v]))
+            .collect();
+        Ok(Proxy {
+            kind: ProxyKind::Refined,
+            shape: refined,
+            origin,
+            location,
+        })
+    }
+}
+
+/// The point halfway between two points of one input triangle, on its corners (heaviest
+/// first, ties to the lower index).
+fn halfway(p: &SurfacePoint, q: &SurfacePoint) -> SurfacePoint {
+    let mut corners: Vec<(u32, f64)> = Vec::with_capacity(6);
+    for (v, w) in p
+        .vertices
+        .iter()
+        .zip(p.weights)
+        .chain(q.vertices.iter().zip(q.weights))
+    {
+        if w <= 0.0 {
+            continue;
+        }
+        match corners.iter_mut().find(|(u, _)| u == v) {
+            Some((_, total)) => *total += 0.5 * w,
+            None => corners.push((*v, 0.5 * w)),
+        }
+    }
+    corners.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+    let mut point = SurfacePoint::at(corners[0].0);
+    for (i, &(v, w)) in corners.iter().take(3).enumerate() {
+        point.vertices[i] = v;
+        point.weights[i] = w;
+    }
+    point
 }
 
 /// Triangles per piece of a dense mesh's first simplification pass: meshoptimizer's
@@ -243,7 +366,8 @@ fn simplified_in_pieces(
     Ok(indices)
 }
 
-/// Input vertices located per block between two looks at the cancel flag.
+/// Input vertices located (or triangles refined) per block between two looks at the cancel
+/// flag.
 const LOCATE_BLOCK: usize = 16_384;
 
 /// Where every input vertex of `shape` lies on `proxy` (an inactive vertex where its

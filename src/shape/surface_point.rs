@@ -18,6 +18,14 @@ impl SurfacePoint {
     pub fn nearest(&self) -> u32 {
         self.vertices[0]
     }
+
+    /// Vertex `v` itself (weight 1).
+    pub fn at(v: u32) -> SurfacePoint {
+        SurfacePoint {
+            vertices: [v; 3],
+            weights: [1.0, 0.0, 0.0],
+        }
+    }
 }
 
 /// Weights inversely proportional to the distance (a point at distance 0 takes all).

@@ -146,7 +146,20 @@ pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
             1.0 / 3.0,
         ),
     };
-    let lengths = mollified_edge_lengths(&positions, &triangles);
+    let mut triangles = triangles;
+    let mut lengths = mollified_edge_lengths(&positions, &triangles);
+    if shape.intrinsic_delaunay() {
+        // Flipped at about unit size (a power of two: exact), as the Laplacian is built.
+        let longest = lengths.iter().flatten().fold(0.0f64, |m, l| m.max(*l));
+        let scale = crate::shape::power_of_two_near(longest);
+        for l in lengths.iter_mut().flatten() {
+            *l /= scale;
+        }
+        flip_to_intrinsic_delaunay(&mut triangles, &mut lengths);
+        for l in lengths.iter_mut().flatten() {
+            *l *= scale;
+        }
+    }
     Triangulation {
         positions,
         triangles,
@@ -236,6 +249,118 @@ fn mollified_edge_lengths(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec
         }
     }
     lengths
+}
+
+/// Sums of opposite cotangents below minus this are flipped (round-off of a Delaunay edge).
+const DELAUNAY_TOLERANCE: f64 = 1e-10;
+
+/// Flips per edge at most (the flip algorithm terminates in exact arithmetic; this bounds
+/// it under round-off). Not tuned.
+const FLIPS_PER_EDGE: usize = 8;
+
+/// The cotangent of the angle at corner `k` of a triangle of edge lengths `l` (0 for a
+/// degenerate one).
+fn cot_at(l: &[f64; 3], k: usize) -> f64 {
+    let area = heron_area(l[0], l[1], l[2]);
+    if area <= 0.0 {
+        return 0.0;
+    }
+    let (a, b, c) = (l[k], l[(k + 1) % 3], l[(k + 2) % 3]);
+    (b * b + c * c - a * a) / (4.0 * area)
+}
+
+/// Flips the triangulation to its intrinsic Delaunay triangulation (Fisher et al. 2007, "An
+/// algorithm for the construction of intrinsic Delaunay triangulations"; Sharp and Crane
+/// 2020, section 4.3): an edge of two triangles whose opposite angles sum above pi (negative
+/// cotangent weight) is replaced by the other diagonal of their quad, its length found by
+/// laying the quad flat, until none is left. The surface and its vertices are unchanged.
+/// Edges of one or of more than two triangles stay; so does a flip that would make an edge
+/// that exists. Returns the number of flips; deterministic (a stack in triangle order).
+pub(crate) fn flip_to_intrinsic_delaunay(
+    triangles: &mut [[u32; 3]],
+    lengths: &mut [[f64; 3]],
+) -> usize {
+    let key = |u: u32, v: u32| (u.min(v), u.max(v));
+    let mut edges: std::collections::HashMap<(u32, u32), Vec<(usize, usize)>> =
+        std::collections::HashMap::with_capacity(3 * triangles.len() / 2);
+    let mut stack = Vec::with_capacity(3 * triangles.len() / 2);
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let e = key(tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let around = edges.entry(e).or_default();
+            if around.is_empty() {
+                stack.push(e);
+            }
+            around.push((t, k));
+        }
+    }
+    stack.reverse();
+    let limit = FLIPS_PER_EDGE * stack.len();
+    let mut flips = 0;
+    while let Some(e) = stack.pop() {
+        if flips >= limit {
+            break;
+        }
+        let Some(&[(t1, k1), (t2, k2)]) = edges.get(&e).map(Vec::as_slice) else {
+            continue;
+        };
+        if cot_at(&lengths[t1], k1) + cot_at(&lengths[t2], k2) >= -DELAUNAY_TOLERANCE {
+            continue;
+        }
+        let (a, b) = (triangles[t1][k1], triangles[t2][k2]);
+        if a == b || edges.contains_key(&key(a, b)) {
+            continue;
+        }
+        let (i, j) = e;
+        // The length of the edge of triangle t from v's opposite corner's view: the edge
+        // opposite the corner that is `v`.
+        let opposite = |t: usize, v: u32| {
+            let c = triangles[t].iter().position(|&x| x == v).unwrap_or(0);
+            lengths[t][c]
+        };
+        let (ai, aj, bi, bj) = (
+            opposite(t1, j),
+            opposite(t1, i),
+            opposite(t2, j),
+            opposite(t2, i),
+        );
+        // The quad laid flat: i at the origin, j on the x axis, a above, b below.
+        let ij = lengths[t1][k1];
+        let x = |to_i: f64, to_j: f64| (to_i * to_i - to_j * to_j + ij * ij) / (2.0 * ij);
+        let (xa, xb) = (x(ai, aj), x(bi, bj));
+        let (ya, yb) = (
+            (ai * ai - xa * xa).max(0.0).sqrt(),
+            (bi * bi - xb * xb).max(0.0).sqrt(),
+        );
+        let ab = ((xa - xb).powi(2) + (ya + yb).powi(2)).sqrt();
+        let new = ([bi, ab, ai], [aj, ab, bj]);
+        if heron_area(new.0[0], new.0[1], new.0[2]) <= 0.0
+            || heron_area(new.1[0], new.1[1], new.1[2]) <= 0.0
+        {
+            continue;
+        }
+        triangles[t1] = [a, i, b];
+        lengths[t1] = new.0;
+        triangles[t2] = [b, j, a];
+        lengths[t2] = new.1;
+        edges.remove(&e);
+        edges.insert(key(a, b), vec![(t1, 1), (t2, 1)]);
+        for (edge, from, to) in [
+            (key(a, i), t1, (t1, 2)),
+            (key(a, j), t1, (t2, 0)),
+            (key(b, i), t2, (t1, 0)),
+            (key(b, j), t2, (t2, 2)),
+        ] {
+            if let Some(around) = edges.get_mut(&edge) {
+                if let Some(slot) = around.iter_mut().find(|(t, _)| *t == from) {
+                    *slot = to;
+                }
+            }
+            stack.push(edge);
+        }
+        flips += 1;
+    }
+    flips
 }
 
 /// Triangle area from its edge lengths, by Kahan's numerically stable form of Heron's formula.

@@ -435,3 +435,44 @@ pub fn mirror_map(rest: &FigureMesh) -> Vec<u32> {
         .map(|p| tree.nearest(&[-p[0], p[1], p[2]]) as u32)
         .collect()
 }
+
+/// `mesh` simplified by meshoptimizer's edge collapse to about `target_vertices` vertices
+/// (plain quadric error, no regularisation: long thin triangles as in low-poly assets), with
+/// the index in `mesh` of every kept vertex (ascending): a decimated figure keeps its
+/// ground truth by index. Errors with [`Error::InvalidParameter`] for fewer than 16 vertices.
+pub fn decimate(mesh: &FigureMesh, target_vertices: usize) -> Result<(FigureMesh, Vec<u32>)> {
+    if target_vertices < 16 {
+        return Err(Error::InvalidParameter {
+            name: "target_vertices",
+            reason: format!("a decimated figure needs 16 or more vertices, got {target_vertices}"),
+        });
+    }
+    let positions: Vec<[f32; 3]> = mesh.vertices.iter().map(|p| p.map(|x| x as f32)).collect();
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    // A closed surface has about two triangles per vertex; the error bound is left open.
+    let kept = meshopt::simplify_decoder(
+        &indices,
+        &positions,
+        6 * target_vertices,
+        1.0,
+        meshopt::SimplifyOptions::None,
+        None,
+    );
+    let mut original: Vec<u32> = kept.clone();
+    original.sort_unstable();
+    original.dedup();
+    let index = |v: u32| original.binary_search(&v).unwrap_or_default() as u32;
+    Ok((
+        FigureMesh {
+            vertices: original
+                .iter()
+                .map(|&v| mesh.vertices[v as usize])
+                .collect(),
+            triangles: kept
+                .chunks_exact(3)
+                .map(|t| [index(t[0]), index(t[1]), index(t[2])])
+                .collect(),
+        },
+        original,
+    ))
+}

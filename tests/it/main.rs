@@ -15,6 +15,7 @@ mod heat_geodesics;
 mod hypotheses;
 mod io_files;
 mod limits;
+mod low_poly;
 mod matching;
 mod multiresolution;
 mod pieces;

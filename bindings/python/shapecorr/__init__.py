@@ -152,6 +152,7 @@ class RegionOptions(TypedDict, total=False):
     verify_hypotheses: BoolValue
     proxy_above: IntValue
     proxy_vertices: IntValue
+    refine_below: IntValue
     max_vertices: IntValue
     memory_limit_mib: IntValue
     time_limit_s: FloatValue

@@ -317,6 +317,8 @@ pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> ser
         "n_vertices_b": b.n_vertices(),
         "kind_a": a.kind(),
         "kind_b": b.kind(),
+        "working_a": result.working[0],
+        "working_b": result.working[1],
         "k": result.k,
         "regions_a": result.regions_a(),
         "regions_b": result.regions_b(),

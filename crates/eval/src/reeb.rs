@@ -32,6 +32,7 @@
 
 use std::time::Instant;
 
+use shapecorr::pipeline::multiresolution::Working;
 use shapecorr::pipeline::{one_to_one_matches, Correspondence, Params, Timings};
 use shapecorr::regions::graph::ShapeGraph;
 use shapecorr::regions::matching::match_graphs;
@@ -433,5 +434,6 @@ pub fn reeb_correspondence(
         timings,
         verdict: None,
         estimate: None,
+        working: [a, b].map(|s| Working::of(s, None)),
     })
 }

@@ -227,6 +227,9 @@ fn match_and_symmetry_write_their_results() {
     assert!(!result["matches"].as_array().unwrap().is_empty());
     assert!(!result["matches_one_to_one"].as_array().unwrap().is_empty());
     assert!(result["timings_s"]["total"].as_f64().unwrap() > 0.0);
+    // 3,000 vertices are above `refine_below` and below `proxy_above`: run as they are.
+    assert_eq!(result["working_a"]["kind"], "input");
+    assert_eq!(result["working_b"]["vertices"], result["n_vertices_b"]);
     assert_eq!(result["version"], env!("CARGO_PKG_VERSION"));
     let confidence = check_verdict(&result, &String::from_utf8_lossy(&out.stderr));
     assert!(confidence.is_some(), "verified by default");
