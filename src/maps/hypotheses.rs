@@ -685,9 +685,9 @@ const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.
 
 /// Landmark errors within this distance of the best one (on the unit-area A) count as
 /// equally good: the cost decides among them. About a tenth of a body's height: replayed on
-/// 310 development pairs with two landmarks each (docs/placement.md, "Landmarks"), 0.1 left
-/// 11 pairs above 0.05 and 0.05 left 16 (a right hypothesis's landmarks land up to 0.1 from
-/// their partners before they are pinned); a cost cap did no better.
+/// the 438 development pairs with two landmarks each (docs/placement.md, "Landmarks"), 0.1
+/// left 11 pairs above 0.05 and 0.05 left 16 (a right hypothesis's landmarks land up to 0.1
+/// from their partners before they are pinned); a cost cap did no better.
 pub const LANDMARK_TOLERANCE: f64 = 0.1;
 
 impl Verdict {

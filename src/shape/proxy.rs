@@ -208,8 +208,16 @@ impl Proxy {
         // Midpoint subdivision keeps a low-poly mesh's long thin triangles; their intrinsic
         // Delaunay flips give the Laplacian non-negative weights (docs/decisions.md,
         // "Low-poly meshes: a refined working mesh": 300-vertex pairs 0.067 -> 0.025).
-        let refined =
-            Shape::mesh_with(vertices, &polygons, &Repairs::none())?.with_intrinsic_delaunay();
+        // A shape whose pieces were joined has its refined copy joined too.
+        let repairs = Repairs {
+            join_gap: if shape.bridges().is_empty() {
+                0.0
+            } else {
+                Repairs::default().join_gap
+            },
+            ..Repairs::none()
+        };
+        let refined = Shape::mesh_with(vertices, &polygons, &repairs)?.with_intrinsic_delaunay();
         let representative = shape.representative();
         let location = (0..shape.n_vertices())
             .map(|v| SurfacePoint::at(representative[v]))

@@ -136,7 +136,6 @@ pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
             let triangles: Vec<[u32; 3]> = shape
                 .triangles()
                 .iter()
-                .chain(shape.bridges())
                 .map(|t| t.map(|v| compact[v as usize]))
                 .collect();
             (triangles, 1.0)
@@ -159,6 +158,18 @@ pub(crate) fn triangulation(shape: &Shape) -> Triangulation {
         for l in lengths.iter_mut().flatten() {
             *l *= scale;
         }
+    }
+    if !shape.bridges().is_empty() {
+        // The bridges after the flips: they join pieces, they are not part of a surface.
+        let mut compact = vec![u32::MAX; shape.n_vertices()];
+        for (i, &v) in shape.active_vertices().iter().enumerate() {
+            compact[v as usize] = i as u32;
+        }
+        let bridges: Vec<[u32; 3]> = (shape.bridges().iter())
+            .map(|t| t.map(|v| compact[v as usize]))
+            .collect();
+        lengths.extend(mollified_edge_lengths(&positions, &bridges));
+        triangles.extend(bridges);
     }
     Triangulation {
         positions,

@@ -35,7 +35,7 @@ def landmark_pick(hs, start, rule):
 
 def main():
     data = pairs(sys.argv[1:])
-    rules = [RULE, (0.1, None), (0.05, 3.0), (0.1, 3.0), (0.05, 2.0), (0.1, 2.0), (0.2, 3.0), (0.05, 5.0)]
+    rules = [RULE, (0.05, None), (0.05, 3.0), (0.1, 3.0), (0.05, 2.0), (0.1, 2.0), (0.2, 3.0), (0.05, 5.0)]
     rows = {r: [] for r in rules}
     for key, hs in sorted(data.items()):
         if any("error" not in h for h in hs):
