@@ -80,7 +80,7 @@ pub const PLACEMENT_COST_RATIO: f64 = 1.35;
 /// figures modelled in pieces, where the frame's map cost 2.0-2.9 times the cheapest and was
 /// right, docs/decisions.md, "Shapes in pieces"). On the development pairs in their own
 /// frames this happened once, at 7.9 times, with a right region answer; with B turned at
-/// random the frame's map cost at least RANDOM_TURN_MIN_RATIO times (docs/placement.md).
+/// random it cost 22-98 times (20 FAUST_r pairs, docs/placement.md).
 pub const FRAME_ONLY_COST_RATIO: f64 = 3.5;
 
 /// The proper rotation `R` that best sends `from` onto `to` (`to[i] ~ R from[i] + t`, least
