@@ -347,6 +347,11 @@ static CACHE_INFO_DEFAULT: [CacheInfo; 3] = [
 	},
 ];
 
+/// shapecorr: the largest L3 share the packing scratch is sized for. No core of a real
+/// machine has more L3 to itself (16 MiB is the 2-core reference machine's share); a
+/// larger scratch only reserves address space.
+const MAX_L3_SHARE: usize = 16 << 20;
+
 pub struct CacheInfoDeref;
 
 impl core::ops::Deref for CacheInfoDeref {
@@ -366,6 +371,9 @@ impl core::ops::Deref for CacheInfoDeref {
 
 			val[2].cache_bytes = Ord::max(val[2].cache_bytes, CACHE_INFO_DEFAULT[2].cache_bytes);
 			val[2].cache_bytes = Ord::max(val[2].cache_bytes, val[1].cache_bytes.checked_mul(4).unwrap());
+			// shapecorr: at most MAX_L3_SHARE (never below L2): a virtual machine that reports a
+			// 480 MiB L3 shared by 2 CPUs made every thread's scratch 480 MiB of address space.
+			val[2].cache_bytes = Ord::min(val[2].cache_bytes, Ord::max(MAX_L3_SHARE, val[1].cache_bytes));
 			val
 		})
 	}
