@@ -372,10 +372,16 @@ fn damaged_foreign_or_unstorable_cache_entries_give_the_answers_of_a_fresh_run()
     let reference = dir.join("ref");
     ok(batch(&reference, &dir.join("cache0")));
     let expected = pair_answers(&reference);
-    let keys: Vec<String> = lines(&reference.join("shapes.jsonl"))
+    // Shape i's key (the log's lines come in the order the shapes finished).
+    let mut named: Vec<(String, String)> = lines(&reference.join("shapes.jsonl"))
         .iter()
-        .map(|r| r["key"].as_str().unwrap().to_string())
+        .map(|r| {
+            let text = |field: &str| r[field].as_str().unwrap().to_string();
+            (text("name"), text("key"))
+        })
         .collect();
+    named.sort();
+    let keys: Vec<String> = named.into_iter().map(|(_, key)| key).collect();
     let entry = |cache: &Path, i: usize| cache.join(format!("{}.basis", keys[i]));
 
     // fig0's entry with flipped exponent bits, fig1's holding fig2's valid entry.
