@@ -285,7 +285,8 @@ static void test_repairs(void) {
     CHECK(strstr(warnings, "welded") == NULL, "no weld asked for: %s", warnings);
     CHECK(strstr(warnings, "disconnected") != NULL, "the soup stays in pieces: %s", warnings);
     CHECK(sc_shape_repairs(as_given, warnings, sizeof warnings) == 0, "no repair: %s", warnings);
-    CHECK_STATUS(sc_shape_new_mesh_repaired(soup, 3 * m, soup_triangles, m, 8, &bad),
+    unsigned unknown_repair = SC_REPAIR_ALL + 1;
+    CHECK_STATUS(sc_shape_new_mesh_repaired(soup, 3 * m, soup_triangles, m, unknown_repair, &bad),
                  SC_STATUS_INVALID_ARGUMENT);
     CHECK(bad == NULL, "no shape from unknown repair flags");
     CHECK_STATUS(sc_shape_new_point_cloud_repaired(xyz, n, SC_REPAIR_ALL, &bad), SC_STATUS_OK);
