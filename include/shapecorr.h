@@ -52,8 +52,9 @@
 // The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
 #define SC_STAGE_POINTWISE_MAP 7
 
-// Simplifying a dense shape to its proxy and bringing the answers back to every input
-// vertex (the multiresolution path, above `proxy_above` vertices).
+// Making the working shape (a dense shape's simplified proxy, above `proxy_above`
+// vertices; a low-poly mesh's refined copy, below `refine_below`) and bringing the answers
+// back to every input vertex: the first and the last stage reported on that path.
 #define SC_STAGE_PROXY 8
 
 // Carrying data from A to B (`sc_surface_map_new`).
@@ -137,7 +138,8 @@
 // triangle soups).
 #define SC_REPAIR_WELD 1
 
-// Repair flag: leave out small loose pieces (scan debris).
+// Repair flag: leave out small loose pieces (scan debris) and separate objects (pieces not
+// joined to the largest one: a prop beside the figure).
 #define SC_REPAIR_DEBRIS 2
 
 // Repair flag: leave out far vertices and a point cloud's isolated points.

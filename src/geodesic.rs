@@ -567,7 +567,13 @@ mod tests {
         let offset = vertices.len() as u32;
         vertices.extend(second.iter().map(|p| [p[0] + 10.0, p[1], p[2]]));
         triangles.extend(second_triangles.iter().map(|t| t.map(|v| v + offset)));
-        let shape = Shape::mesh(vertices, &triangles).unwrap();
+        // The repairs would leave the second grid out as a separate object.
+        let keep_pieces = crate::shape::Repairs {
+            debris_fraction: 0.0,
+            ..Default::default()
+        };
+        let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+        let shape = Shape::mesh_with(vertices, &polygons, &keep_pieces).unwrap();
         let d = edge_graph_distances(&shape, &[0], 1.0);
         assert!(d[..offset as usize].iter().all(|x| x.is_finite()));
         assert!(d[offset as usize..].iter().all(|x| *x == f64::INFINITY));

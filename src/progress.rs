@@ -19,8 +19,8 @@ pub enum Stage {
     SymmetryBreaking = 6,
     /// Point-to-point map (functional map and its refinement).
     PointwiseMap = 7,
-    /// Simplifying a dense shape to its proxy and bringing the answers back to every input
-    /// vertex (the multiresolution path, [`crate::multiresolution`]).
+    /// Making the working shape (a dense shape's proxy, a low-poly mesh's refined copy) and
+    /// bringing the answers back to every input vertex ([`crate::multiresolution`]).
     Proxy = 8,
     /// Carrying data from A to B: the surface map and the transfer ([`crate::transfer`]).
     Transfer = 9,

@@ -33,7 +33,8 @@ unsafe fn xyz_input<'a, T>(xyz: *const T, n_vertices: usize) -> FfiResult<&'a [T
 /// Repair flags of the `*_repaired` constructors: weld coincident vertices (seams,
 /// triangle soups).
 pub const SC_REPAIR_WELD: u32 = 1;
-/// Repair flag: leave out small loose pieces (scan debris).
+/// Repair flag: leave out small loose pieces (scan debris) and separate objects (pieces not
+/// joined to the largest one: a prop beside the figure).
 pub const SC_REPAIR_DEBRIS: u32 = 2;
 /// Repair flag: leave out far vertices and a point cloud's isolated points.
 pub const SC_REPAIR_OUTLIERS: u32 = 4;

@@ -19,6 +19,7 @@ use std::collections::HashMap;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::io::RawShape;
 use crate::shape::neighbors::{symmetric_knn_graph, PointTree};
+use crate::shape::repair::PieceRole;
 pub use crate::shape::repair::Repairs;
 pub use crate::shape::warning::Warning;
 use crate::{Error, Result};
@@ -361,7 +362,7 @@ impl Shape {
             Vec::new()
         };
         cancel.check()?;
-        let keep = repair::keep_large_pieces(
+        let roles = repair::piece_roles_of_triangles(
             vertices,
             &triangles,
             &bridges,
@@ -369,28 +370,18 @@ impl Shape {
             cancel,
         )?;
         cancel.check()?;
-        if keep.iter().any(|&k| !k) {
-            let before = used_by(&triangles).len();
-            let mut pieces = DisjointSets::new(n);
-            let small: Vec<[u32; 3]> = triangles
-                .iter()
-                .zip(&keep)
-                .filter(|(_, &k)| !k)
-                .map(|(t, _)| *t)
-                .collect();
-            for t in &small {
-                pieces.union(t[0] as usize, t[1] as usize);
-                pieces.union(t[1] as usize, t[2] as usize);
+        if roles.iter().any(|&r| r != PieceRole::Kept) {
+            let left_out = left_out_pieces(n, &triangles, &roles);
+            let mut role = roles.iter();
+            triangles.retain(|_| role.next() == Some(&PieceRole::Kept));
+            let (pieces, vertices) = left_out.debris;
+            if pieces > 0 {
+                warnings.push(Warning::SmallPiecesDropped { pieces, vertices });
             }
-            let mut roots: Vec<usize> = small.iter().map(|t| pieces.find(t[0] as usize)).collect();
-            roots.sort_unstable();
-            roots.dedup();
-            let mut k = keep.iter();
-            triangles.retain(|_| *k.next().unwrap_or(&true));
-            warnings.push(Warning::SmallPiecesDropped {
-                pieces: roots.len(),
-                vertices: before - used_by(&triangles).len(),
-            });
+            let (pieces, vertices) = left_out.separate;
+            if pieces > 0 {
+                warnings.push(Warning::SeparateObjectsDropped { pieces, vertices });
+            }
         }
         let active = used_by(&triangles);
         if !bridges.is_empty() {
@@ -467,20 +458,17 @@ impl Shape {
         }
         cancel.check()?;
         if active.len() >= MIN_VERTICES {
-            let before = active.len();
-            let (kept, pieces) = repair::keep_large_cloud_pieces(
-                vertices,
-                &active,
-                repairs.debris_fraction,
-                cancel,
-            )?;
+            let (kept, left_out) =
+                repair::keep_cloud_figure(vertices, &active, repairs.debris_fraction, cancel)?;
+            let (pieces, vertices) = left_out.debris;
             if pieces > 0 {
-                warnings.push(Warning::SmallPiecesDropped {
-                    pieces,
-                    vertices: before - kept.len(),
-                });
-                active = kept;
+                warnings.push(Warning::SmallPiecesDropped { pieces, vertices });
             }
+            let (pieces, vertices) = left_out.separate;
+            if pieces > 0 {
+                warnings.push(Warning::SeparateObjectsDropped { pieces, vertices });
+            }
+            active = kept;
         }
         Ok(Repaired {
             triangles: Vec::new(),
@@ -857,6 +845,42 @@ struct Repaired {
 }
 
 /// Connected pieces of the vertices used by `triangles` and `bridges`.
+/// The pieces left out by `roles` (one per triangle, [`PieceRole`]) and their vertices
+/// (a vertex of a piece that is kept is not counted).
+fn left_out_pieces(n: usize, triangles: &[[u32; 3]], roles: &[PieceRole]) -> repair::LeftOut {
+    let mut kept = vec![false; n];
+    let mut pieces = DisjointSets::new(n);
+    for (t, &role) in triangles.iter().zip(roles) {
+        if role == PieceRole::Kept {
+            t.iter().for_each(|&v| kept[v as usize] = true);
+        } else {
+            pieces.union(t[0] as usize, t[1] as usize);
+            pieces.union(t[1] as usize, t[2] as usize);
+        }
+    }
+    let mut role_of_root: HashMap<usize, (PieceRole, usize)> = HashMap::new();
+    let mut counted = vec![false; n];
+    for (t, &role) in triangles.iter().zip(roles) {
+        if role == PieceRole::Kept {
+            continue;
+        }
+        let entry = role_of_root
+            .entry(pieces.find(t[0] as usize))
+            .or_insert((role, 0));
+        for &v in t {
+            if !kept[v as usize] && !counted[v as usize] {
+                counted[v as usize] = true;
+                entry.1 += 1;
+            }
+        }
+    }
+    let mut left_out = repair::LeftOut::default();
+    for (role, vertices) in role_of_root.into_values() {
+        left_out.add(role, vertices);
+    }
+    left_out
+}
+
 fn count_pieces_of(n: usize, triangles: &[[u32; 3]], bridges: &[[u32; 3]]) -> usize {
     let mut sets = DisjointSets::new(n);
     let mut used = vec![false; n];

@@ -180,40 +180,75 @@ pub fn weld(points: &[[f64; 3]], of: &[u32], tolerance: f64, cancel: &Cancel) ->
     Ok(root)
 }
 
-/// The triangles to keep: those of every connected piece holding at least `fraction` of the
-/// total area, when at least one piece does (else all of them). Pieces joined by `bridges`
-/// ([`bridges_between_pieces`]) count as one.
-pub fn keep_large_pieces(
+/// What the repairs do with a connected piece of a shape (pieces joined by
+/// [`bridges_between_pieces`] count as one).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PieceRole {
+    /// The figure: the largest piece (all pieces when none is larger than debris).
+    Kept,
+    /// A small loose piece (less than [`Repairs::debris_fraction`] of the shape): left out.
+    Debris,
+    /// A piece as large as a part but not joined to the largest one (a prop, a base, a
+    /// second object beside the figure): left out. The spectral stages need one connected
+    /// surface: two pieces have two constant eigenfunctions, which a refinement sample
+    /// cannot tell apart (docs/scans.md, "Props").
+    Separate,
+}
+
+/// Every piece's role from its size (`sizes[p]`: area or point count), with `fraction`
+/// the debris fraction (0: nothing left out).
+fn piece_roles(sizes: &[f64], fraction: f64) -> Vec<PieceRole> {
+    let total: f64 = sizes.iter().sum();
+    let large = |s: f64| s >= fraction * total;
+    if !(fraction > 0.0) || !sizes.iter().any(|&s| large(s)) {
+        return vec![PieceRole::Kept; sizes.len()];
+    }
+    // The first of equal largest pieces, so that the choice does not depend on the order.
+    let largest = (0..sizes.len())
+        .max_by(|&i, &j| sizes[i].total_cmp(&sizes[j]).then(j.cmp(&i)))
+        .unwrap_or(0);
+    (0..sizes.len())
+        .map(|p| match p {
+            p if p == largest => PieceRole::Kept,
+            p if large(sizes[p]) => PieceRole::Separate,
+            _ => PieceRole::Debris,
+        })
+        .collect()
+}
+
+/// Every triangle's piece role ([`PieceRole`]): pieces holding less than `fraction` of the
+/// area are debris, the largest piece is kept, the others are separate objects; pieces
+/// joined by `bridges` ([`bridges_between_pieces`]) count as one.
+pub fn piece_roles_of_triangles(
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
     bridges: &[[u32; 3]],
     fraction: f64,
     cancel: &Cancel,
-) -> Result<Vec<bool>> {
+) -> Result<Vec<PieceRole>> {
     let mut sets = DisjointSets::new(vertices.len());
     for (i, t) in triangles.iter().chain(bridges).enumerate() {
         cancel.check_every(i)?;
         sets.union(t[0] as usize, t[1] as usize);
         sets.union(t[1] as usize, t[2] as usize);
     }
-    let mut area_of: HashMap<usize, f64> = HashMap::new();
-    let mut roots: Vec<usize> = Vec::with_capacity(triangles.len());
+    // Pieces numbered in the order of their first triangle.
+    let mut piece_of_root: HashMap<usize, usize> = HashMap::new();
+    let mut piece: Vec<usize> = Vec::with_capacity(triangles.len());
+    let mut area: Vec<f64> = Vec::new();
     for (i, t) in triangles.iter().enumerate() {
         cancel.check_every(i)?;
-        roots.push(sets.find(t[0] as usize));
+        let root = sets.find(t[0] as usize);
+        let next = piece_of_root.len();
+        let p = *piece_of_root.entry(root).or_insert(next);
+        if p == area.len() {
+            area.push(0.0);
+        }
+        area[p] += super::triangle_area(vertices, t);
+        piece.push(p);
     }
-    let mut total = 0.0;
-    for (i, (t, &r)) in triangles.iter().zip(&roots).enumerate() {
-        cancel.check_every(i)?;
-        let area = super::triangle_area(vertices, t);
-        *area_of.entry(r).or_default() += area;
-        total += area;
-    }
-    let large = |r: &usize| area_of[r] >= fraction * total;
-    if !(fraction > 0.0) || !area_of.keys().any(large) {
-        return Ok(vec![true; triangles.len()]);
-    }
-    Ok(roots.iter().map(large).collect())
+    let roles = piece_roles(&area, fraction);
+    Ok(piece.iter().map(|&p| roles[p]).collect())
 }
 
 /// Triangles that join the connected pieces of a mesh (of at least
@@ -345,17 +380,18 @@ impl CloudNeighbourhoods {
     }
 }
 
-/// Of a point cloud's points `of`, those in pieces ([`PIECE_LINK_SPACINGS`]) holding at least
-/// `fraction` of the points (all of them when no piece does), and the number of pieces
-/// left out.
-pub fn keep_large_cloud_pieces(
+/// A point cloud's points `of` that are kept ([`PieceRole`]: pieces linked by
+/// [`PIECE_LINK_SPACINGS`], those under `fraction` of the points are debris, the largest is
+/// kept, the others are separate objects), and how many debris and separate pieces were
+/// left out with how many points.
+pub fn keep_cloud_figure(
     points: &[[f64; 3]],
     of: &[u32],
     fraction: f64,
     cancel: &Cancel,
-) -> Result<(Vec<u32>, usize)> {
+) -> Result<(Vec<u32>, LeftOut)> {
     if !(fraction > 0.0) || of.len() <= LINK_NEIGHBOURS {
-        return Ok((of.to_vec(), 0));
+        return Ok((of.to_vec(), LeftOut::default()));
     }
     let hood = CloudNeighbourhoods::new(points, of, cancel)?;
     let mut sets = DisjointSets::new(of.len());
@@ -367,23 +403,53 @@ pub fn keep_large_cloud_pieces(
             }
         }
     }
-    let root: Vec<usize> = (0..of.len()).map(|i| sets.find(i)).collect();
-    let mut count: HashMap<usize, usize> = HashMap::new();
-    for &r in &root {
-        *count.entry(r).or_default() += 1;
+    let mut piece_of_root: HashMap<usize, usize> = HashMap::new();
+    let mut count: Vec<f64> = Vec::new();
+    let piece: Vec<usize> = (0..of.len())
+        .map(|i| {
+            let next = piece_of_root.len();
+            let p = *piece_of_root.entry(sets.find(i)).or_insert(next);
+            if p == count.len() {
+                count.push(0.0);
+            }
+            count[p] += 1.0;
+            p
+        })
+        .collect();
+    let roles = piece_roles(&count, fraction);
+    let mut left_out = LeftOut::default();
+    for (p, role) in roles.iter().enumerate() {
+        left_out.add(*role, count[p] as usize);
     }
-    let large = |r: &usize| count[r] as f64 >= fraction * of.len() as f64;
-    if !count.keys().any(large) {
-        return Ok((of.to_vec(), 0));
-    }
-    let dropped = count.keys().filter(|r| !large(r)).count();
     let kept = of
         .iter()
-        .zip(&root)
-        .filter(|(_, r)| large(r))
+        .zip(&piece)
+        .filter(|(_, &p)| roles[p] == PieceRole::Kept)
         .map(|(&v, _)| v)
         .collect();
-    Ok((kept, dropped))
+    Ok((kept, left_out))
+}
+
+/// The pieces the repairs left out, and their vertices, by role.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LeftOut {
+    /// Debris pieces and their vertices.
+    pub debris: (usize, usize),
+    /// Separate objects and their vertices.
+    pub separate: (usize, usize),
+}
+
+impl LeftOut {
+    /// Counts a piece of `vertices` vertices with its role.
+    pub fn add(&mut self, role: PieceRole, vertices: usize) {
+        let slot = match role {
+            PieceRole::Kept => return,
+            PieceRole::Debris => &mut self.debris,
+            PieceRole::Separate => &mut self.separate,
+        };
+        slot.0 += 1;
+        slot.1 += vertices;
+    }
 }
 
 fn median(mut values: Vec<f64>) -> f64 {

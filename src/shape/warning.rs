@@ -76,6 +76,15 @@ pub enum Warning {
         /// Number of their vertices.
         vertices: usize,
     },
+    /// Pieces as large as a part of the figure but not joined to its largest piece (a prop,
+    /// a base, a second object) were left out ([`Repairs::debris_fraction`] switches it
+    /// off with the debris rule); their vertices take the answer of the nearest kept vertex.
+    SeparateObjectsDropped {
+        /// Number of pieces left out.
+        pieces: usize,
+        /// Number of their vertices.
+        vertices: usize,
+    },
     /// Vertices far from the rest of the shape were left out ([`Repairs::outliers`]), with
     /// their faces; they take the values of the nearest kept vertex.
     FarVerticesDropped {
@@ -99,6 +108,7 @@ impl Warning {
             Warning::VerticesWelded { .. }
                 | Warning::PiecesJoined { .. }
                 | Warning::SmallPiecesDropped { .. }
+                | Warning::SeparateObjectsDropped { .. }
                 | Warning::FarVerticesDropped { .. }
                 | Warning::OutlierPointsDropped { .. }
         )
@@ -150,6 +160,10 @@ impl std::fmt::Display for Warning {
             Warning::SmallPiecesDropped { pieces, vertices } => write!(
                 f,
                 "{pieces} small loose pieces ({vertices} vertices) left out as debris; they take the answer of the nearest kept vertex"
+            ),
+            Warning::SeparateObjectsDropped { pieces, vertices } => write!(
+                f,
+                "{pieces} separate object(s) beside the figure ({vertices} vertices, not joined to its largest piece) left out; they take the answer of the nearest kept vertex"
             ),
             Warning::FarVerticesDropped { count } => write!(
                 f,

@@ -47,6 +47,7 @@ mod field;
 mod geom;
 mod pieces;
 mod polygonize;
+mod props;
 mod sampling;
 mod skeleton;
 mod skinning;
@@ -58,6 +59,7 @@ use crate::{Error, Result};
 use geom::V3;
 
 pub use pieces::{cut_into_pieces, PiecesMesh};
+pub use props::box_beside;
 pub use sampling::{sample_points, SampledCloud};
 
 /// The kinds of figure.

@@ -112,7 +112,13 @@ fn bad_sources_are_errors_and_pieces_without_a_source_are_unreachable() {
     let offset = vertices.len() as u32;
     vertices.extend(g.vertices().iter().map(|p| [p[0] + 5.0, p[1], p[2]]));
     triangles.extend(g.triangles().iter().map(|t| t.map(|v| v + offset)));
-    let two = Shape::mesh(vertices, &triangles).unwrap();
+    // The repairs would leave the second grid out as a separate object.
+    let keep_pieces = shapecorr::shape::Repairs {
+        debris_fraction: 0.0,
+        ..Default::default()
+    };
+    let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+    let two = Shape::mesh_with(vertices, &polygons, &keep_pieces).unwrap();
     let d = HeatGeodesics::new(&two).unwrap().distances(&[0]).unwrap();
     assert!(d[..offset as usize].iter().all(|x| x.is_finite()));
     assert!(d[offset as usize..].iter().all(|x| x.is_infinite()));

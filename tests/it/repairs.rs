@@ -1,6 +1,7 @@
 //! What real files contain (docs/decisions.md, "Repairs"; `../shared/reliability` items 10-16), made from a
 //! generated humanoid pair whose ground truth is exact: seams split, a triangle soup, scan
-//! debris, a far vertex, a point cloud with an outlier or every point twice. Each must be
+//! debris, a box beside the figure, a far vertex, a point cloud with an outlier, a box
+//! beside it or every point twice. Each must be
 //! repaired (with its warning) to within 0.02 of the clean pair's one-to-one region
 //! accuracy and 1.5x its map error, and `Repairs::none()` keeps the input as it is.
 
@@ -227,6 +228,19 @@ fn seams_soups_debris_and_far_vertices_are_repaired() {
     // Debris vertices take the answer of the nearest kept vertex; the map never reaches them.
     repaired("debris", debris, dropped, &clean_a.shape, &b, baseline);
 
+    // A box a tenth of the height standing 6% of the height beside a foot (a prop, 13% of
+    // the vertices; beyond two of this coarse figure's edge lengths): a separate object.
+    let boxed = synth::box_beside(&mesh_a, 0.1, 0.06, 8);
+    let n_a = mesh_a.vertices.len() as u32;
+    let boxed = Corrupted {
+        original: (0..boxed.vertices.len() as u32)
+            .map(|v| (v < n_a).then_some(v))
+            .collect(),
+        shape: Shape::mesh(boxed.vertices, &boxed.triangles).unwrap(),
+    };
+    let separate = |w: &Warning| matches!(w, Warning::SeparateObjectsDropped { pieces: 1, .. });
+    repaired("box beside", boxed, separate, &clean_a.shape, &b, baseline);
+
     // One vertex thrown far away (a corrupt coordinate).
     let mut vertices = mesh_a.vertices.clone();
     vertices[100] = [1e9, 0.0, 0.0];
@@ -274,6 +288,13 @@ fn point_clouds_with_outliers_and_duplicates_are_repaired() {
     truth.push(u32::MAX);
     check("one far outlier", points, truth, |w| {
         matches!(w, Warning::FarVerticesDropped { count: 1 })
+    });
+    // A box a tenth of the height beside a foot, as far from it as it is wide.
+    let boxed = synth::box_beside(&mesh_b, 0.1, 0.1, 8);
+    let mut truth = identity.clone();
+    truth.resize(boxed.vertices.len(), u32::MAX);
+    check("box beside", boxed.vertices, truth, |w| {
+        matches!(w, Warning::SeparateObjectsDropped { pieces: 1, .. })
     });
     let mut points = mesh_b.vertices.clone();
     points.extend(mesh_b.vertices.iter().copied());

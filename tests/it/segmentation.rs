@@ -726,7 +726,13 @@ fn segment_pair_falls_back_when_no_k_is_acceptable() {
     vertices.extend(star.vertices.iter().map(|v| [v[0] + 5.0, v[1], v[2]]));
     let mut triangles = star.triangles.clone();
     triangles.extend(star.triangles.iter().map(|t| t.map(|v| v + n)));
-    let two = prepare(Shape::mesh(vertices, &triangles).unwrap());
+    // The repairs would leave the second star out as a separate object.
+    let keep_pieces = shapecorr::shape::Repairs {
+        debris_fraction: 0.0,
+        ..Default::default()
+    };
+    let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+    let two = prepare(Shape::mesh_with(vertices, &polygons, &keep_pieces).unwrap());
     let params = SegmentationParams {
         k_min: 3,
         k_max: 5,

@@ -313,7 +313,13 @@ fn oriented_triangles_turn_flipped_and_inward_faces_outward() {
     let n = v.len() as u32;
     let mut two_f = inward.clone();
     two_f.extend(f.iter().map(|t| t.map(|i| i + n)));
-    let two = Shape::mesh(two_v, &two_f).unwrap();
+    // The repairs would leave the second sphere out as a separate object.
+    let keep_pieces = shapecorr::shape::Repairs {
+        debris_fraction: 0.0,
+        ..Default::default()
+    };
+    let polygons: Vec<Vec<u32>> = two_f.iter().map(|t| t.to_vec()).collect();
+    let two = Shape::mesh_with(two_v, &polygons, &keep_pieces).unwrap();
     let oriented = two.oriented_triangles().unwrap();
     assert!(outward(&oriented[..f.len()]));
     assert!(oriented[f.len()..]

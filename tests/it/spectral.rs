@@ -324,7 +324,13 @@ fn two_pieces_and_unreferenced_vertices_are_handled() {
     vertices.extend([[0.0, 0.0, 2.0], [5.0, 0.0, 2.0], [0.0, 0.0, 0.0]]);
     let mut faces = f.clone();
     faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
-    let shape = Shape::mesh(vertices, &faces).unwrap();
+    // The repairs would leave the second sphere out as a separate object.
+    let keep_pieces = shapecorr::shape::Repairs {
+        debris_fraction: 0.0,
+        ..Default::default()
+    };
+    let polygons: Vec<Vec<u32>> = faces.iter().map(|t| t.to_vec()).collect();
+    let shape = Shape::mesh_with(vertices, &polygons, &keep_pieces).unwrap();
     assert_eq!(shape.n_pieces(), 2);
     assert!(shape
         .warnings()

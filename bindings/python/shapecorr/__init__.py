@@ -324,7 +324,8 @@ class Shape(_Handle):
 
         ``repair``: ``True`` (the default) welds coincident vertices (UV seams, triangle
         soups), joins pieces that come close for matching (no face is added) and leaves out
-        small loose pieces and far vertices; ``False`` uses the mesh as given; or a
+        small loose pieces, separate objects (pieces not joined to the largest one) and far
+        vertices; ``False`` uses the mesh as given; or a
         collection of ``"weld"``, ``"debris"``, ``"outliers"``, ``"join"``. Every vertex
         keeps its index; the repairs made are in :attr:`warnings`."""
         vertices = np.asarray(vertices)

@@ -516,7 +516,11 @@ def consistent_labels(out: FilePath, template: str | None = None) -> dict[str, N
     """For a one-to-many run: every shape's regions labelled by the template's regions.
     Returns ``{name: labels}`` with one int per vertex: the template region its region is
     matched to one-to-one, -1 where it is unmatched; the template's own labels as they are.
-    ``template`` defaults to the A of the run's pairs (which must be one shape)."""
+    ``template`` defaults to the A of the run's pairs (which must be one shape).
+
+    The segmentation is joint per pair, so the template's regions may differ from pair to
+    pair; the template's labels are those of its pair with the first B by name, and a region
+    of another pair's template takes the label most of its vertices carry there."""
     records = [r for r in _records(out) if r["ok"]]
     templates = {r["a"] for r in records}
     if template is None:
@@ -524,13 +528,19 @@ def consistent_labels(out: FilePath, template: str | None = None) -> dict[str, N
             raise ValueError(f"the run has {len(templates)} shapes as A; name the template")
         template = templates.pop()
     labels: dict[str, NDArray[np.int64]] = {}
-    for r in records:
-        if r["a"] != template:
-            continue
-        labels.setdefault(template, np.asarray(r["regions_a"], dtype=np.int64))
+    canonical: NDArray[np.int64] | None = None
+    for r in sorted((r for r in records if r["a"] == template), key=lambda r: r["b"]):
+        regions_a = np.asarray(r["regions_a"], dtype=np.int64)
+        if canonical is None:
+            canonical = regions_a
+            labels[template] = canonical
+        # This pair's regions of the template, each to the label most of its vertices carry.
+        to_canonical = np.full(max(int(regions_a.max(initial=0)) + 1, 1), -1, dtype=np.int64)
+        for region in np.unique(regions_a):
+            to_canonical[region] = np.bincount(canonical[regions_a == region]).argmax()
         lookup = np.full(max(r["n_regions_b"], 1), -1, dtype=np.int64)
         for region_a, region_b in r["matches_one_to_one"]:
-            lookup[region_b] = region_a
+            lookup[region_b] = to_canonical[region_a]
         labels[r["b"]] = lookup[np.asarray(r["regions_b"], dtype=np.int64)]
     if not labels:
         raise ValueError(f"no finished pair has {template!r} as A")

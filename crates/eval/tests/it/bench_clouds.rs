@@ -46,7 +46,13 @@ fn two_squares() -> Shape {
     let (v2, t2) = grid(3.0, 2.0, 10, vertices.len() as u32);
     vertices.extend(v2);
     triangles.extend(t2);
-    Shape::mesh(vertices, &triangles).unwrap()
+    // Both squares kept: the repairs would leave the small one out as a separate object.
+    let keep_pieces = shapecorr::shape::Repairs {
+        debris_fraction: 0.0,
+        ..Default::default()
+    };
+    let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+    Shape::mesh_with(vertices, &polygons, &keep_pieces).unwrap()
 }
 
 #[test]
