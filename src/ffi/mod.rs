@@ -64,8 +64,9 @@ pub const SC_STAGE_MATCHING: u32 = 5;
 pub const SC_STAGE_SYMMETRY_BREAKING: u32 = 6;
 /// The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
 pub const SC_STAGE_POINTWISE_MAP: u32 = 7;
-/// Simplifying a dense shape to its proxy and bringing the answers back to every input
-/// vertex (the multiresolution path, above `proxy_above` vertices).
+/// Simplifying a dense shape to its proxy (above `proxy_above` vertices) or refining a
+/// low-poly mesh (below `refine_below`), and bringing the answers back to every input vertex
+/// (`sc_correspondence_working` says which side ran on what).
 pub const SC_STAGE_PROXY: u32 = 8;
 /// Carrying data from A to B (`sc_surface_map_new`).
 pub const SC_STAGE_TRANSFER: u32 = 9;
