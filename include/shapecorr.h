@@ -52,9 +52,10 @@
 // The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
 #define SC_STAGE_POINTWISE_MAP 7
 
-// Making the working shape (a dense shape's simplified proxy, above `proxy_above`
-// vertices; a low-poly mesh's refined copy, below `refine_below`) and bringing the answers
-// back to every input vertex: the first and the last stage reported on that path.
+// Simplifying a dense shape to its proxy (above `proxy_above` vertices) or refining a
+// low-poly mesh (below `refine_below`), and bringing the answers back to every input vertex:
+// the first and the last stage on that path (`sc_correspondence_working` says which side
+// ran on what).
 #define SC_STAGE_PROXY 8
 
 // Carrying data from A to B (`sc_surface_map_new`).
@@ -92,6 +93,17 @@
 // answer is doubtful and has a warning (`sc_correspondence_warning`,
 // `sc_pointwise_warning`).
 #define SC_CONFIDENCE_DOUBTFUL_BELOW 0.45
+
+// The pipeline ran on the input shape itself (`sc_correspondence_working`).
+#define SC_WORKING_INPUT 0
+
+// The pipeline ran on a simplified proxy of a dense shape (options `proxy_above`,
+// `proxy_vertices`); the answers were brought back to every input vertex.
+#define SC_WORKING_PROXY 1
+
+// The pipeline ran on a refined copy of a low-poly mesh (option `refine_below`); the
+// answers were brought back to every input vertex.
+#define SC_WORKING_REFINED 2
 
 // An integer option (`sc_params_set_int`).
 #define SC_OPTION_INT 0
@@ -589,6 +601,20 @@ double sc_correspondence_hypothesis_cost(const sc_correspondence *correspondence
 // `correspondence` must be NULL or live.
 double sc_correspondence_turn_degrees(const sc_correspondence *correspondence, uint32_t which);
 
+// What the pipeline ran on for one side (`SC_SIDE_A` or `SC_SIDE_B`): `out_kind` gets
+// `SC_WORKING_INPUT`, `SC_WORKING_PROXY` or `SC_WORKING_REFINED`, `out_vertices` that
+// shape's vertices (the input's active ones for `SC_WORKING_INPUT`). Nothing is written on
+// error.
+//
+// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
+//
+// # Safety
+// `correspondence` must be live; `out_kind` and `out_vertices` writable.
+sc_status sc_correspondence_working(const sc_correspondence *correspondence,
+                                    uint32_t side,
+                                    uint32_t *out_kind,
+                                    size_t *out_vertices);
+
 // What settled the choice among the hypotheses (static; never free it): `"cost"` (the
 // cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
 // stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
@@ -811,6 +837,16 @@ sc_status sc_pointwise_fmap(const sc_pointwise *pointwise, double *out_fmap, siz
 // `pointwise` must be live; `out_correspondence` writable.
 sc_status sc_pointwise_regions(const sc_pointwise *pointwise,
                                sc_correspondence **out_correspondence);
+
+// What the pipeline ran on for one side, as `sc_correspondence_working` (the map was
+// computed on the same working shapes as its regions).
+//
+// # Safety
+// `pointwise` must be live; `out_kind` and `out_vertices` writable.
+sc_status sc_pointwise_working(const sc_pointwise *pointwise,
+                               uint32_t side,
+                               uint32_t *out_kind,
+                               size_t *out_vertices);
 
 // Seconds spent in a stage of the call: `stage` is one of `"eigenbasis_a"`,
 // `"eigenbasis_b"`, `"regions"` (the region correspondence after the eigenbases), `"fmap"`

@@ -122,8 +122,10 @@ ADVICE = (
 def report(result, shapes=()):
     """The lines of the report on a match: the confidence of the answer (``confidence
     0.74``, or ``not verified`` when it has none) and how it was chosen (:func:`choice_text`),
-    ``warning: ...`` and what to do (:data:`ADVICE`) when it is doubtful, and ``repaired A:
-    ...`` for every repair the library made to ``shapes`` (A, then B)."""
+    ``warning: ...`` and what to do (:data:`ADVICE`) when it is doubtful, ``repaired A:
+    ...`` for every repair the library made to ``shapes`` (A, then B; pieces joined for
+    matching among them), and what a side was matched on when not its input
+    (:func:`working_lines`)."""
     confidence = result.confidence
     first = "not verified" if confidence is None else f"confidence {confidence:.2f}"
     choice = choice_text(result)
@@ -133,6 +135,23 @@ def report(result, shapes=()):
         lines.append(ADVICE)
     for side, shape in zip("AB", shapes):
         lines.extend(f"repaired {side}: {repair}" for repair in shape.repairs)
+    lines.extend(working_lines(result, shapes))
+    return lines
+
+
+def working_lines(result, shapes=()):
+    """``A was matched on a refined copy of 1,204 vertices (the input has 290)`` (or ``a
+    proxy of``) for each side the library ran on a refined copy of a low-poly mesh or a proxy
+    of a dense one (``result.working``); nothing for a side matched on its input."""
+    lines = []
+    for index, (kind, vertices) in enumerate(getattr(result, "working", ())):
+        if kind == "input":
+            continue
+        what = "a refined copy" if kind == "refined" else "a proxy"
+        side = "ab"[index]
+        inputs = shapes[index].n_vertices if shapes else getattr(result, f"n_vertices_{side}", None)
+        inputs = len(result.regions(side)) if inputs is None else inputs
+        lines.append(f"{side.upper()} was matched on {what} of {vertices:,} vertices (the input has {inputs:,})")
     return lines
 
 

@@ -132,6 +132,24 @@ def repair_notes(names, shapes):
     return [f"shapecorr: '{name}': {repair}" for name, shape in zip(names, shapes) for repair in shape.repairs]
 
 
+def working_notes(names, result):
+    """One report line per object that the library matched on a proxy (a dense mesh) or a
+    refined copy (a low-poly mesh) rather than on its input (``result.working``); none for
+    results that do not say (symmetry)."""
+    working = getattr(result, "working", None)
+    if working is None:
+        return []
+    notes = []
+    for name, side, (kind, vertices) in zip(names, "ab", working):
+        if kind == "input":
+            continue
+        what = "a refined copy" if kind == "refined" else "a proxy"
+        inputs = getattr(result, f"n_vertices_{side}", None)
+        inputs = len(result.regions(side)) if inputs is None else inputs
+        notes.append(f"shapecorr: '{name}' was matched on {what} of {vertices:,} vertices (the input has {inputs:,})")
+    return notes
+
+
 def write_regions(obj, regions, rgba):
     """Writes the region ids and colours as point attributes of ``obj``'s mesh, makes the
     colour attribute the active (and rendered) one."""
@@ -311,6 +329,9 @@ class _LibraryOperator:
         # What the library repaired in the input (welded seams, debris left out, ...).
         for note in getattr(self, "_repairs", []):
             self.report({"WARNING"}, note)
+        # What each side ran on, when not its input (docs/decisions.md, "Low-poly meshes").
+        for note in working_notes(getattr(self, "_names", []), result):
+            self.report({"INFO"}, note)
         # A doubtful answer (results that have a confidence) is also a warning.
         warning = getattr(result, "warning", None)
         if warning:

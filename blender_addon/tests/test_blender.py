@@ -207,6 +207,57 @@ def test_a_mesh_split_along_a_seam_is_welded_and_the_repair_reported(addon, capf
     assert np.array_equal(regions[len(va):], regions[original[len(va):]])
 
 
+def split_apart(vertices, triangles, gap):
+    """:func:`seam_split`, then the +x side moved ``gap`` further along x: two pieces of one
+    figure that come close without touching, as a model in parts."""
+    vertices, split, original = seam_split(vertices, triangles)
+    right = vertices[split].sum(axis=1)[:, 0] > 0.0
+    moved = np.zeros(len(vertices), dtype=bool)
+    moved[split[right].ravel()] = True
+    vertices = vertices.copy()
+    vertices[moved, 0] += gap
+    return vertices, split, original
+
+
+def test_pieces_joined_for_matching_are_reported(addon, capfd):
+    """A figure in two pieces 0.5% of its height apart (within the 1% the library joins,
+    docs/decisions.md, "Shapes in pieces"): a warning report on that object says they were
+    joined; both ran on their input, so no line says what they were matched on."""
+    fresh_scene()
+    (va, ta), (vb, tb) = figures(addon)
+    vertices, triangles, _ = split_apart(va, ta, 0.005 * np.ptp(va, axis=0).max())
+    shape = addon.shapecorr.Shape.mesh(vertices, triangles)
+    assert not any("welded" in r for r in shape.repairs), shape.repairs
+    a = add_object("Parts", vertices, triangles)
+    b = add_object("Posed", vb, tb, location=(3.0, 0.0, 0.0))
+    select(a, b)
+    reports(capfd)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    found = reports(capfd)
+    assert any(level == "Warning" and "'Parts'" in text and "joined" in text for level, text in found), found
+    assert not any("was matched on" in text for _, text in found), found
+
+
+def test_a_low_poly_mesh_is_reported_as_matched_on_a_refined_copy(addon, capfd):
+    """A figure of 600 vertices (below ``refine_below``, 2,000) runs on a refined copy: one
+    info report names it with both sizes; the 2,500-vertex one ran on its input."""
+    fresh_scene()
+    low = addon.shapecorr.Shape.figure("humanoid", 0, 600)
+    (vb, tb), = figures(addon, poses=(3,))
+    a = add_object("Fox", low.vertices, low.triangles)
+    b = add_object("Posed", vb, tb, location=(3.0, 0.0, 0.0))
+    select(a, b)
+    reports(capfd)
+    assert bpy.ops.shapecorr.match_regions() == {"FINISHED"}
+    lines = [text for _, text in reports(capfd) if "was matched on" in text]
+    expected = addon.shapecorr.match(low, addon.shapecorr.Shape.figure("humanoid", 3, SIZE)).working[0]
+    assert expected.kind == "refined" and expected.vertices > low.n_vertices
+    assert lines == [
+        f"shapecorr: 'Fox' was matched on a refined copy of {expected.vertices:,} vertices "
+        f"(the input has {low.n_vertices:,})"
+    ], lines
+
+
 def test_undo_removes_the_attributes(addon):
     operator = addon.operators.SHAPECORR_OT_match_regions
     assert {"REGISTER", "UNDO"} <= operator.bl_options

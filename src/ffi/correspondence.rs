@@ -10,6 +10,7 @@ use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
 use super::verdict::{self, VerdictText};
 use super::{CallbackProgress, ScProgressCallback};
+use crate::pipeline::multiresolution::WorkingKind;
 use crate::pipeline::Correspondence;
 use crate::regions::graph::ShapeGraph;
 
@@ -43,6 +44,14 @@ pub const SC_MATCHES_ONE_TO_ONE: u32 = 1;
 /// answer is doubtful and has a warning (`sc_correspondence_warning`,
 /// `sc_pointwise_warning`).
 pub const SC_CONFIDENCE_DOUBTFUL_BELOW: f64 = 0.45;
+/// The pipeline ran on the input shape itself (`sc_correspondence_working`).
+pub const SC_WORKING_INPUT: u32 = 0;
+/// The pipeline ran on a simplified proxy of a dense shape (options `proxy_above`,
+/// `proxy_vertices`); the answers were brought back to every input vertex.
+pub const SC_WORKING_PROXY: u32 = 1;
+/// The pipeline ran on a refined copy of a low-poly mesh (option `refine_below`); the
+/// answers were brought back to every input vertex.
+pub const SC_WORKING_REFINED: u32 = 2;
 
 /// Region correspondence between shapes `a` and `b` (meshes, point clouds or one of each):
 /// eigenbases, heat kernel signatures, joint segmentation over the range of k, spectral
@@ -468,6 +477,59 @@ pub unsafe extern "C" fn sc_correspondence_turn_degrees(
     })
 }
 
+/// What the pipeline ran on for one side (`SC_SIDE_A` or `SC_SIDE_B`): `out_kind` gets
+/// `SC_WORKING_INPUT`, `SC_WORKING_PROXY` or `SC_WORKING_REFINED`, `out_vertices` that
+/// shape's vertices (the input's active ones for `SC_WORKING_INPUT`). Nothing is written on
+/// error.
+///
+/// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
+///
+/// # Safety
+/// `correspondence` must be live; `out_kind` and `out_vertices` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_working(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_kind: *mut u32,
+    out_vertices: *mut usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        write_working(&c.result, side, out_kind, out_vertices)
+    })
+}
+
+/// Writes side `side`'s working shape of `result` (`sc_correspondence_working`).
+///
+/// # Safety
+/// `out_kind` and `out_vertices` must be NULL or writable.
+pub(crate) unsafe fn write_working(
+    result: &Correspondence,
+    side: u32,
+    out_kind: *mut u32,
+    out_vertices: *mut usize,
+) -> FfiResult {
+    let working = match side {
+        SC_SIDE_A | SC_SIDE_B => result.working[side as usize],
+        _ => {
+            return Err(Failure::invalid(format!(
+                "side must be SC_SIDE_A (0) or SC_SIDE_B (1), got {side}"
+            )))
+        }
+    };
+    let kind = out_kind.as_mut().ok_or_else(|| Failure::null("out_kind"))?;
+    let vertices = out_vertices
+        .as_mut()
+        .ok_or_else(|| Failure::null("out_vertices"))?;
+    *kind = match working.kind {
+        WorkingKind::Input => SC_WORKING_INPUT,
+        WorkingKind::Proxy => SC_WORKING_PROXY,
+        WorkingKind::Refined => SC_WORKING_REFINED,
+    };
+    *vertices = working.vertices;
+    Ok(())
+}
+
 /// What settled the choice among the hypotheses (static; never free it): `"cost"` (the
 /// cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
 /// stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
@@ -598,10 +660,9 @@ mod tests {
                 ruled_out: vec![false; 2],
             }),
             estimate: None,
-            working: [crate::pipeline::multiresolution::Working {
-                kind: crate::pipeline::multiresolution::WorkingKind::Input,
-                vertices: 0,
-            }; 2],
+            working: [(WorkingKind::Input, 300), (WorkingKind::Refined, 1200)].map(
+                |(kind, vertices)| crate::pipeline::multiresolution::Working { kind, vertices },
+            ),
         });
         std::sync::Arc::into_raw(std::sync::Arc::new(correspondence))
     }
@@ -704,6 +765,41 @@ mod tests {
             assert!(sc_correspondence_warning(std::ptr::null()).is_null());
             let message = CStr::from_ptr(super::super::sc_last_error());
             assert!(message.to_str().unwrap().contains("correspondence"));
+        }
+    }
+
+    #[test]
+    fn working_gives_each_sides_kind_and_size_and_checks_its_arguments() {
+        let c = with_verdict(None);
+        unsafe {
+            let (mut kind, mut vertices) = (99, 99);
+            let expected = [(SC_WORKING_INPUT, 300), (SC_WORKING_REFINED, 1200)];
+            for (side, want) in [SC_SIDE_A, SC_SIDE_B].into_iter().zip(expected) {
+                let status = sc_correspondence_working(c, side, &mut kind, &mut vertices);
+                assert_eq!(status, ScStatus::Ok);
+                assert_eq!((kind, vertices), want);
+            }
+            let (mut kind, mut vertices) = (99, 99);
+            assert_eq!(
+                sc_correspondence_working(c, 2, &mut kind, &mut vertices),
+                ScStatus::InvalidArgument
+            );
+            let message = CStr::from_ptr(super::super::sc_last_error());
+            assert!(message.to_str().unwrap().contains("side"));
+            assert_eq!(
+                sc_correspondence_working(c, SC_SIDE_A, std::ptr::null_mut(), &mut vertices),
+                ScStatus::NullArgument
+            );
+            assert_eq!(
+                sc_correspondence_working(c, SC_SIDE_A, &mut kind, std::ptr::null_mut()),
+                ScStatus::NullArgument
+            );
+            assert_eq!(
+                sc_correspondence_working(std::ptr::null(), 0, &mut kind, &mut vertices),
+                ScStatus::NullArgument
+            );
+            assert_eq!((kind, vertices), (99, 99), "nothing written on failure");
+            sc_correspondence_free(c.cast_mut());
         }
     }
 }

@@ -64,9 +64,10 @@ pub const SC_STAGE_MATCHING: u32 = 5;
 pub const SC_STAGE_SYMMETRY_BREAKING: u32 = 6;
 /// The point-to-point map (functional map and its refinement; `sc_pointwise_map` only).
 pub const SC_STAGE_POINTWISE_MAP: u32 = 7;
-/// Making the working shape (a dense shape's simplified proxy, above `proxy_above`
-/// vertices; a low-poly mesh's refined copy, below `refine_below`) and bringing the answers
-/// back to every input vertex: the first and the last stage reported on that path.
+/// Simplifying a dense shape to its proxy (above `proxy_above` vertices) or refining a
+/// low-poly mesh (below `refine_below`), and bringing the answers back to every input vertex:
+/// the first and the last stage on that path (`sc_correspondence_working` says which side
+/// ran on what).
 pub const SC_STAGE_PROXY: u32 = 8;
 /// Carrying data from A to B (`sc_surface_map_new`).
 pub const SC_STAGE_TRANSFER: u32 = 9;

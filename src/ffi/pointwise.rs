@@ -6,7 +6,7 @@ use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
     Failure, FfiResult, ScStatus,
 };
-use super::correspondence::{ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
+use super::correspondence::{write_working, ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
 use super::verdict::{self, VerdictText};
@@ -203,6 +203,24 @@ pub unsafe extern "C" fn sc_pointwise_regions(
             out_correspondence,
             ScCorrespondence::new(p.result.regions.clone()),
         )
+    })
+}
+
+/// What the pipeline ran on for one side, as `sc_correspondence_working` (the map was
+/// computed on the same working shapes as its regions).
+///
+/// # Safety
+/// `pointwise` must be live; `out_kind` and `out_vertices` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_working(
+    pointwise: *const ScPointwise,
+    side: u32,
+    out_kind: *mut u32,
+    out_vertices: *mut usize,
+) -> ScStatus {
+    boundary(|| {
+        let p = handle(pointwise, "pointwise")?;
+        write_working(&p.result.regions, side, out_kind, out_vertices)
     })
 }
 

@@ -49,9 +49,10 @@ fi
 # not: it runs every test that hands memory across the API once, each handle's whole life
 # cycle and every getter into a caller's buffer (correspondence, symmetry, pointwise map,
 # surface map, batch), the error paths, a cancel in each kind of job, and calls from several
-# threads. It skips three tests that only run sc_match again, with no API call of their own
-# (point_cloud, unverified_has_no_confidence, and cancellation, which cancels at each stage):
-# they run whole plain and under ASan+UBSan+LSan above (a sixth of valgrind's time).
+# threads. It skips four tests that only run sc_match again, with no API call of their own
+# (point_cloud, unverified_has_no_confidence, working, whose accessor life_cycle runs, and
+# cancellation, which cancels at each stage): they run whole plain and under
+# ASan+UBSan+LSan above (a sixth of valgrind's time).
 ownership=(version status_text options option_extremes shape_errors repairs match_errors
     resource_limits life_cycle cancel_huge_restarts symmetry pointwise_options pointwise_errors
     pointwise_permuted_copy pointwise_cancellation transfer handles_in_use surface_map_shapes batch

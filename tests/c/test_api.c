@@ -315,6 +315,7 @@ struct progress_log {
 static bool record_progress(void *userdata, uint32_t stage, float fraction) {
     struct progress_log *log = (struct progress_log *)userdata;
     log->calls++;
+    /* SC_STAGE_PROXY too: quick sizes (700 vertices) run on refined copies. */
     if (stage < SC_STAGE_LAPLACIAN || stage > SC_STAGE_PROXY || !(fraction >= 0.0f) ||
         !(fraction <= 1.0f))
         log->bad++;
@@ -370,6 +371,53 @@ static void check_confidence(const char *what, double confidence, const char *wa
            warning != NULL ? warning : "");
 }
 
+/* What the pipeline ran on for one side of `c` whose input has `n` vertices: the input
+ * itself from 2,000 vertices (option `refine_below`), else a refined copy with more
+ * vertices; the bad side and NULL arguments fail and write nothing. */
+static void check_working(const sc_correspondence *c, uint32_t side, size_t n) {
+    uint32_t kind = 99;
+    size_t vertices = 0;
+    CHECK_STATUS(sc_correspondence_working(c, side, &kind, &vertices), SC_STATUS_OK);
+    if (n >= 2000)
+        CHECK(kind == SC_WORKING_INPUT && vertices == n, "side %u of %zu vertices: kind %u, %zu",
+              side, n, kind, vertices);
+    else
+        CHECK(kind == SC_WORKING_REFINED && vertices > n,
+              "side %u of %zu vertices: kind %u, %zu", side, n, kind, vertices);
+    kind = 99;
+    vertices = 0;
+    CHECK_STATUS(sc_correspondence_working(c, 2, &kind, &vertices), SC_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(sc_last_error(), "side") != NULL, "message: %s", sc_last_error());
+    CHECK_STATUS(sc_correspondence_working(c, side, NULL, &vertices), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_working(c, side, &kind, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_working(NULL, side, &kind, &vertices), SC_STATUS_NULL_ARGUMENT);
+    CHECK(kind == 99 && vertices == 0, "nothing written on failure");
+}
+
+/* A low-poly figure (600 vertices) runs on a refined copy, the plain one beside it on
+ * itself. */
+static void test_working(void) {
+    sc_shape *a = NULL, *b = figure("star4", 2);
+    sc_params *params = NULL;
+    sc_correspondence *c = NULL;
+    CHECK_STATUS(sc_shape_new_figure("star4", 0, 600, &a), SC_STATUS_OK);
+    if (a == NULL || b == NULL)
+        goto done;
+    CHECK(sc_shape_n_vertices(a) < 2000, "a low-poly figure: %zu", sc_shape_n_vertices(a));
+    CHECK_STATUS(sc_params_new(&params), SC_STATUS_OK);
+    CHECK_STATUS(sc_params_set_bool(params, "verify_hypotheses", false), SC_STATUS_OK);
+    CHECK_STATUS(sc_match(a, b, params, NULL, NULL, &c), SC_STATUS_OK);
+    if (c != NULL) {
+        check_working(c, SC_SIDE_A, sc_shape_n_vertices(a));
+        check_working(c, SC_SIDE_B, sc_shape_n_vertices(b));
+    }
+done:
+    sc_correspondence_free(c);
+    sc_params_free(params);
+    sc_shape_free(a);
+    sc_shape_free(b);
+}
+
 static void test_life_cycle(void) {
     sc_shape *a = figure("humanoid", 0), *b_mesh = figure("humanoid", 3), *b = NULL;
     sc_params *params = NULL;
@@ -420,6 +468,8 @@ static void test_life_cycle(void) {
            sc_shape_n_vertices(a), nv, sc_correspondence_k(c), na, nb, sym, one);
     CHECK(sym >= (quick ? 0.7 : 0.9), "symmetric accuracy %.3f", sym);
     check_confidence("life cycle", sc_correspondence_confidence(c), sc_correspondence_warning(c));
+    check_working(c, SC_SIDE_A, sc_shape_n_vertices(a));
+    check_working(c, SC_SIDE_B, nv);
     CHECK(sc_correspondence_warning(c) == sc_correspondence_warning(c),
           "the warning is the handle's own string");
     CHECK(sc_correspondence_n_matches(c, SC_MATCHES_ONE_TO_ONE) <=
@@ -885,11 +935,17 @@ static void test_pointwise_permuted_copy(void) {
     params = pointwise_params();
     CHECK_STATUS(sc_pointwise_map(a, b, params, record_progress, &log, &p), SC_STATUS_OK);
     CHECK(log.calls > 5 && log.bad == 0, "%d progress calls, %d bad", log.calls, log.bad);
-    /* Quick sizes are below `refine_below`: the answers come back from a refined copy. */
-    CHECK(log.last_stage == (quick ? SC_STAGE_PROXY : SC_STAGE_POINTWISE_MAP), "last stage %u",
-          log.last_stage);
     if (p == NULL)
         goto done;
+    {
+        /* The map is brought back to the input vertices last when it ran on a copy. */
+        uint32_t kind = 99;
+        size_t vertices = 0;
+        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, &kind, &vertices), SC_STATUS_OK);
+        CHECK(log.last_stage ==
+                  (kind == SC_WORKING_INPUT ? SC_STAGE_POINTWISE_MAP : SC_STAGE_PROXY),
+              "last stage %u, working kind %u", log.last_stage, kind);
+    }
     CHECK(sc_pointwise_n_vertices(p, SC_SIDE_A) == n, "n A");
     CHECK(sc_pointwise_n_vertices(p, SC_SIDE_B) == n, "n B");
     CHECK(sc_pointwise_n_vertices(p, 2) == 0, "bad side counts 0");
@@ -953,6 +1009,25 @@ static void test_pointwise_permuted_copy(void) {
     CHECK(sc_correspondence_n_vertices(regions, SC_SIDE_B) == n, "regions of B");
     CHECK(sc_correspondence_n_matches(regions, SC_MATCHES_ONE_TO_ONE) >= 5, "%zu matches",
           sc_correspondence_n_matches(regions, SC_MATCHES_ONE_TO_ONE));
+    {
+        /* The map ran on the working shapes of its regions. */
+        uint32_t kind = 99, regions_kind = 98;
+        size_t vertices = 0, regions_vertices = 1;
+        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_B, &kind, &vertices), SC_STATUS_OK);
+        CHECK_STATUS(sc_correspondence_working(regions, SC_SIDE_B, &regions_kind,
+                                               &regions_vertices),
+                     SC_STATUS_OK);
+        CHECK(kind == regions_kind && vertices == regions_vertices,
+              "pointwise working %u of %zu, its regions' %u of %zu", kind, vertices,
+              regions_kind, regions_vertices);
+        CHECK(kind == (n < 2000 ? SC_WORKING_REFINED : SC_WORKING_INPUT), "kind %u for %zu", kind,
+              n);
+        CHECK_STATUS(sc_pointwise_working(p, 2, &kind, &vertices), SC_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, NULL, &vertices),
+                     SC_STATUS_NULL_ARGUMENT);
+        CHECK_STATUS(sc_pointwise_working(NULL, SC_SIDE_A, &kind, &vertices),
+                     SC_STATUS_NULL_ARGUMENT);
+    }
 
     /* Confidences: the map's answer and its regions', each in range with its warning. */
     check_confidence("pointwise", sc_pointwise_confidence(p), sc_pointwise_warning(p));
@@ -1756,6 +1831,7 @@ static const struct {
     {"life_cycle", test_life_cycle},
     {"point_cloud", test_point_cloud},
     {"unverified_has_no_confidence", test_unverified_has_no_confidence},
+    {"working", test_working},
     {"cancellation", test_cancellation},
     {"cancel_huge_restarts", test_cancel_huge_restarts},
     {"symmetry", test_symmetry},

@@ -83,6 +83,8 @@ __all__ = [
     "RefinementChoice",
     "PlacementChoice",
     "Hypothesis",
+    "Working",
+    "WorkingKind",
     "Landmarks",
     "ProgressCallback",
     "RepairSpec",
@@ -801,6 +803,36 @@ class Hypothesis(NamedTuple):
     turn_degrees: float
 
 
+#: What a side ran on (:class:`Working`).
+WorkingKind = Literal["input", "proxy", "refined"]
+_WORKING_KINDS: dict[int, WorkingKind] = {
+    _lib.WORKING_INPUT: "input", _lib.WORKING_PROXY: "proxy", _lib.WORKING_REFINED: "refined",
+}
+
+
+class Working(NamedTuple):
+    """What the pipeline ran on for one side (:attr:`Correspondence.working`): the input
+    itself, a simplified proxy of a dense shape (options ``proxy_above``,
+    ``proxy_vertices``) or a refined copy of a low-poly mesh (``refine_below``). The answers
+    are given on every input vertex whatever it ran on."""
+
+    #: ``"input"``, ``"proxy"`` or ``"refined"``.
+    kind: WorkingKind
+    #: Its vertices (the input's active ones for ``"input"``).
+    vertices: int
+
+
+def _working(function, result) -> tuple[Working, Working]:
+    """Both sides' :class:`Working` through ``sc_correspondence_working`` or
+    ``sc_pointwise_working``."""
+    sides = []
+    for side in (_lib.SIDE_A, _lib.SIDE_B):
+        kind, vertices = ctypes.c_uint32(), ctypes.c_size_t()
+        _check(function(result, side, ctypes.byref(kind), ctypes.byref(vertices)))
+        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value))
+    return sides[0], sides[1]
+
+
 class _Verdict:
     """What a result says about its choice among the verified hypotheses (docs/placement.md),
     read through the C functions named ``{_prefix}_hypothesis`` etc."""
@@ -965,6 +997,12 @@ class Correspondence(_Verdict, _Handle):
         return None if pointer is None else Correspondence(pointer)
 
     @property
+    def working(self) -> tuple[Working, Working]:
+        """What the pipeline ran on for A and B: ``(kind, vertices)`` each, ``kind``
+        ``"input"``, ``"proxy"`` (a dense shape) or ``"refined"`` (a low-poly mesh)."""
+        return _working(lib.sc_correspondence_working, self)
+
+    @property
     def timings(self) -> dict[str, float]:
         """Seconds per stage, and ``total``."""
         out = {}
@@ -1101,6 +1139,11 @@ class PointwiseMap(_Verdict, _Handle):
         """The region correspondence the map was built on (a :class:`Correspondence`; its
         timings count the region stages only)."""
         return Correspondence(_new_handle(lib.sc_pointwise_regions, self))
+
+    @property
+    def working(self) -> tuple[Working, Working]:
+        """What the map was computed on for A and B (as :attr:`Correspondence.working`)."""
+        return _working(lib.sc_pointwise_working, self)
 
     @property
     def timings(self) -> dict[str, float]:

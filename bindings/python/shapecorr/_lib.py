@@ -63,6 +63,7 @@ c_f64p = ctypes.POINTER(ctypes.c_double)
 c_f32p = ctypes.POINTER(ctypes.c_float)
 c_i64p = ctypes.POINTER(ctypes.c_int64)
 c_boolp = ctypes.POINTER(ctypes.c_bool)
+c_size_tp = ctypes.POINTER(ctypes.c_size_t)
 handle_out = ctypes.POINTER(ctypes.c_void_p)
 status = ctypes.c_uint32
 
@@ -197,6 +198,7 @@ FUNCTIONS = {
     "sc_correspondence_hypothesis": (ctypes.c_char_p, [handle, u32_arg]),
     "sc_correspondence_hypothesis_cost": (ctypes.c_double, [handle, u32_arg]),
     "sc_correspondence_turn_degrees": (ctypes.c_double, [handle, u32_arg]),
+    "sc_correspondence_working": (status, [handle, u32_arg, c_u32p, c_size_tp]),
     "sc_correspondence_decided_by": (ctypes.c_char_p, [handle]),
     "sc_correspondence_placement_used": (ctypes.c_bool, [handle]),
     "sc_correspondence_other_answer": (status, [handle, handle_out]),
@@ -218,6 +220,7 @@ FUNCTIONS = {
     "sc_pointwise_fmap_cols": (c_size_t, [handle]),
     "sc_pointwise_fmap": (status, [handle, c_f64p, c_size_t]),
     "sc_pointwise_regions": (status, [handle, handle_out]),
+    "sc_pointwise_working": (status, [handle, u32_arg, c_u32p, c_size_tp]),
     "sc_pointwise_seconds": (status, [handle, c_str, c_f64p]),
     "sc_pointwise_confidence": (ctypes.c_double, [handle]),
     "sc_pointwise_warning": (ctypes.c_char_p, [handle]),
@@ -303,6 +306,8 @@ P2P_REFINEMENT_NONE, P2P_REFINEMENT_ZOOMOUT, P2P_REFINEMENT_ICP = 0, 1, 2
 PLACEMENT_AUTO, PLACEMENT_IGNORE, PLACEMENT_TRUST = 0, 1, 2
 #: ``SC_ANSWER_CHOSEN``, ``SC_ANSWER_RUNNER_UP``: which hypothesis a verdict accessor reads.
 ANSWER_CHOSEN, ANSWER_RUNNER_UP = 0, 1
+#: ``SC_WORKING_INPUT``, ``SC_WORKING_PROXY``, ``SC_WORKING_REFINED``: what a side ran on.
+WORKING_INPUT, WORKING_PROXY, WORKING_REFINED = 0, 1, 2
 #: ``SC_MAX_LANDMARKS``: most landmark pairs a job takes.
 MAX_LANDMARKS = 100
 #: Below this confidence an answer is doubtful and has a warning.

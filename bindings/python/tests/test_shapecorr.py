@@ -359,6 +359,46 @@ def test_no_confidence_without_verification():
     assert lib.sc_pointwise_warning(None) is None
 
 
+def test_working_constants_match_the_header():
+    header = (REPOSITORY / "include" / "shapecorr.h").read_text()
+    found = dict(re.findall(r"#define SC_WORKING_([A-Z]+) ([0-9]+)", header))
+    assert {name: int(value) for name, value in found.items()} == {
+        "INPUT": _lib.WORKING_INPUT, "PROXY": _lib.WORKING_PROXY, "REFINED": _lib.WORKING_REFINED,
+    }
+
+
+def test_working_says_input_proxy_or_refined(humanoids):
+    """A plain figure runs on itself, a low-poly one (600 vertices, below ``refine_below``)
+    on a refined copy with more vertices, a shape above ``proxy_above`` on a smaller proxy."""
+    a, b = humanoids
+    low = shapecorr.Shape.figure("humanoid", 0, 600)
+    assert low.n_vertices < 2000
+    result = shapecorr.match(low, b, verify_hypotheses=False)
+    working_a, working_b = result.working
+    assert isinstance(working_a, shapecorr.Working)
+    assert working_a.kind == "refined" and working_a.vertices > low.n_vertices, working_a
+    assert working_b == ("input", b.n_vertices)
+    assert shapecorr.match(a, b, verify_hypotheses=False).working == (
+        ("input", a.n_vertices), ("input", b.n_vertices),
+    )
+    dense = shapecorr.match(a, b, verify_hypotheses=False, proxy_above=2000, proxy_vertices=1000)
+    assert [w.kind for w in dense.working] == ["proxy", "proxy"]
+    assert all(w.vertices < 2000 for w in dense.working), dense.working
+
+
+def test_working_raw_api_errors(humanoids):
+    a, b = humanoids
+    result = shapecorr.match(a, b, verify_hypotheses=False)
+    lib = _lib.lib
+    kind, vertices = ctypes.c_uint32(7), ctypes.c_size_t(7)
+    names = _lib.STATUS_NAMES
+    assert names[lib.sc_correspondence_working(result, 2, ctypes.byref(kind), ctypes.byref(vertices))] == "INVALID_ARGUMENT"
+    assert names[lib.sc_correspondence_working(result, 0, None, ctypes.byref(vertices))] == "NULL_ARGUMENT"
+    assert names[lib.sc_correspondence_working(None, 0, ctypes.byref(kind), ctypes.byref(vertices))] == "NULL_ARGUMENT"
+    assert names[lib.sc_pointwise_working(None, 0, ctypes.byref(kind), ctypes.byref(vertices))] == "NULL_ARGUMENT"
+    assert (kind.value, vertices.value) == (7, 7), "nothing written on failure"
+
+
 def test_vertices_round_trip_and_float32_input(humanoids):
     a, _ = humanoids
     v, t = a.vertices, a.triangles
@@ -463,6 +503,8 @@ def test_permuted_copy_is_mapped_back(humanoids):
     assert stages[-1][0] == "pointwise_map" and all(0.0 <= f <= 1.0 for _, f in stages)
     assert {s for s, _ in stages} >= {"eigenbasis", "segmentation", "matching", "pointwise_map"}
     assert (result.n_vertices_a, result.n_vertices_b) == (a.n_vertices, b.n_vertices)
+    assert result.working == (("input", a.n_vertices), ("input", b.n_vertices))
+    assert result.working == result.regions.working
     mapped = result.map_b_to_a
     assert mapped.dtype == np.uint32 and mapped.shape == (b.n_vertices,)
     assert mapped.max() < a.n_vertices
