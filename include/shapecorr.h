@@ -603,17 +603,20 @@ double sc_correspondence_turn_degrees(const sc_correspondence *correspondence, u
 
 // What the pipeline ran on for one side (`SC_SIDE_A` or `SC_SIDE_B`): `out_kind` gets
 // `SC_WORKING_INPUT`, `SC_WORKING_PROXY` or `SC_WORKING_REFINED`, `out_vertices` that
-// shape's vertices (the input's active ones for `SC_WORKING_INPUT`). Nothing is written on
-// error.
+// shape's vertices (the input's active ones for `SC_WORKING_INPUT`), and `out_smoothed`
+// (NULL: not asked) whether its positions were smoothed because the input is a noisy mesh
+// (docs/scans.md). Nothing is written on error.
 //
 // Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
 //
 // # Safety
-// `correspondence` must be live; `out_kind` and `out_vertices` writable.
+// `correspondence` must be live; `out_kind` and `out_vertices` writable, `out_smoothed`
+// NULL or writable.
 sc_status sc_correspondence_working(const sc_correspondence *correspondence,
                                     uint32_t side,
                                     uint32_t *out_kind,
-                                    size_t *out_vertices);
+                                    size_t *out_vertices,
+                                    bool *out_smoothed);
 
 // What settled the choice among the hypotheses (static; never free it): `"cost"` (the
 // cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
@@ -842,11 +845,13 @@ sc_status sc_pointwise_regions(const sc_pointwise *pointwise,
 // computed on the same working shapes as its regions).
 //
 // # Safety
-// `pointwise` must be live; `out_kind` and `out_vertices` writable.
+// `pointwise` must be live; `out_kind` and `out_vertices` writable, `out_smoothed` NULL
+// or writable.
 sc_status sc_pointwise_working(const sc_pointwise *pointwise,
                                uint32_t side,
                                uint32_t *out_kind,
-                               size_t *out_vertices);
+                               size_t *out_vertices,
+                               bool *out_smoothed);
 
 // Seconds spent in a stage of the call: `stage` is one of `"eigenbasis_a"`,
 // `"eigenbasis_b"`, `"regions"` (the region correspondence after the eigenbases), `"fmap"`

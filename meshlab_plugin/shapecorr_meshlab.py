@@ -142,13 +142,20 @@ def report(result, shapes=()):
 def working_lines(result, shapes=()):
     """``A was matched on a refined copy of 1,204 vertices (the input has 290)`` (or ``a
     proxy of``) for each side the library ran on a refined copy of a low-poly mesh or a proxy
-    of a dense one (``result.working``); nothing for a side matched on its input."""
+    of a dense one (``result.working``), ``A looks noisy ...`` for one matched on a smoothed
+    copy of a noisy mesh; nothing for a side matched on its input as it is."""
     lines = []
-    for index, (kind, vertices) in enumerate(getattr(result, "working", ())):
+    for index, shape in enumerate(getattr(result, "working", ())):
+        kind, vertices, smoothed = shape[0], shape[1], getattr(shape, "smoothed", False)
+        if kind == "input" and not smoothed:
+            continue
+        side = "ab"[index]
         if kind == "input":
+            lines.append(f"{side.upper()} looks noisy (scanner noise): it was matched on a smoothed copy; the answers are on its own vertices")
             continue
         what = "a refined copy" if kind == "refined" else "a proxy"
-        side = "ab"[index]
+        if smoothed:
+            what = what.replace("a ", "a smoothed ", 1)
         inputs = shapes[index].n_vertices if shapes else getattr(result, f"n_vertices_{side}", None)
         inputs = len(result.regions(side)) if inputs is None else inputs
         lines.append(f"{side.upper()} was matched on {what} of {vertices:,} vertices (the input has {inputs:,})")

@@ -133,17 +133,23 @@ def repair_notes(names, shapes):
 
 
 def working_notes(names, result):
-    """One report line per object that the library matched on a proxy (a dense mesh) or a
-    refined copy (a low-poly mesh) rather than on its input (``result.working``); none for
-    results that do not say (symmetry)."""
+    """One report line per object that the library matched on a proxy (a dense mesh), a
+    refined copy (a low-poly mesh) or a smoothed copy (a noisy mesh) rather than on its input
+    as it is (``result.working``); none for results that do not say (symmetry)."""
     working = getattr(result, "working", None)
     if working is None:
         return []
     notes = []
-    for name, side, (kind, vertices) in zip(names, "ab", working):
+    for name, side, shape in zip(names, "ab", working):
+        kind, vertices, smoothed = shape[0], shape[1], getattr(shape, "smoothed", False)
+        if kind == "input" and not smoothed:
+            continue
         if kind == "input":
+            notes.append(f"shapecorr: '{name}' looks noisy (scanner noise): it was matched on a smoothed copy; the answers are on its own vertices")
             continue
         what = "a refined copy" if kind == "refined" else "a proxy"
+        if smoothed:
+            what = what.replace("a ", "a smoothed ", 1)
         inputs = getattr(result, f"n_vertices_{side}", None)
         inputs = len(result.regions(side)) if inputs is None else inputs
         notes.append(f"shapecorr: '{name}' was matched on {what} of {vertices:,} vertices (the input has {inputs:,})")

@@ -258,6 +258,20 @@ def test_a_low_poly_mesh_is_reported_as_matched_on_a_refined_copy(addon, capfd):
     ], lines
 
 
+def test_the_report_says_a_noisy_object_was_smoothed(addon):
+    from types import SimpleNamespace
+
+    Working = addon.shapecorr.Working
+    result = SimpleNamespace(
+        n_vertices_a=5000, n_vertices_b=250000,
+        working=(Working("input", 5000, True), Working("proxy", 8000, True)),
+    )
+    assert addon.operators.working_notes(["Scan", "Statue"], result) == [
+        "shapecorr: 'Scan' looks noisy (scanner noise): it was matched on a smoothed copy; the answers are on its own vertices",
+        "shapecorr: 'Statue' was matched on a smoothed proxy of 8,000 vertices (the input has 250,000)",
+    ]
+
+
 def test_undo_removes_the_attributes(addon):
     operator = addon.operators.SHAPECORR_OT_match_regions
     assert {"REGISTER", "UNDO"} <= operator.bl_options

@@ -328,6 +328,20 @@ def test_the_report_names_a_proxy_and_is_silent_on_inputs():
     assert shapecorr_meshlab.report(inputs) == ["not verified"]
 
 
+def test_the_report_says_a_noisy_side_was_smoothed():
+    from types import SimpleNamespace
+
+    noisy = SimpleNamespace(
+        confidence=None, warning=None, hypothesis=None, n_vertices_a=5000, n_vertices_b=250000,
+        working=(shapecorr.Working("input", 5000, True), shapecorr.Working("proxy", 8000, True)),
+    )
+    assert shapecorr_meshlab.report(noisy) == [
+        "not verified",
+        "A looks noisy (scanner noise): it was matched on a smoothed copy; the answers are on its own vertices",
+        "B was matched on a smoothed proxy of 8,000 vertices (the input has 250,000)",
+    ]
+
+
 def test_the_report_says_how_the_answer_was_chosen_and_what_to_do():
     from types import SimpleNamespace
 

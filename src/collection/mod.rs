@@ -314,6 +314,7 @@ impl Batch {
         // The working shape's recipe: its basis in the cache is that shape's.
         let reading = match proxy.as_ref().map(|p| p.kind) {
             None => format!("{:?}|proxy=0", self.settings.reading),
+            Some(ProxyKind::Smoothed) => format!("{:?}|proxy=0", self.settings.reading),
             Some(ProxyKind::Simplified) => format!(
                 "{:?}|proxy={}",
                 self.settings.reading, multiresolution.proxy_vertices
@@ -322,6 +323,10 @@ impl Batch {
                 "{:?}|refined={}",
                 self.settings.reading, multiresolution.refine_below
             ),
+        } + if proxy.as_ref().is_some_and(|p| p.smoothed) {
+            "|smoothed"
+        } else {
+            ""
         };
         record.key = BasisCache::file_key(path, &reading, &self.eigen)?;
         let timed = self

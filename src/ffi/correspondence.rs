@@ -479,35 +479,39 @@ pub unsafe extern "C" fn sc_correspondence_turn_degrees(
 
 /// What the pipeline ran on for one side (`SC_SIDE_A` or `SC_SIDE_B`): `out_kind` gets
 /// `SC_WORKING_INPUT`, `SC_WORKING_PROXY` or `SC_WORKING_REFINED`, `out_vertices` that
-/// shape's vertices (the input's active ones for `SC_WORKING_INPUT`). Nothing is written on
-/// error.
+/// shape's vertices (the input's active ones for `SC_WORKING_INPUT`), and `out_smoothed`
+/// (NULL: not asked) whether its positions were smoothed because the input is a noisy mesh
+/// (docs/scans.md). Nothing is written on error.
 ///
 /// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
 ///
 /// # Safety
-/// `correspondence` must be live; `out_kind` and `out_vertices` writable.
+/// `correspondence` must be live; `out_kind` and `out_vertices` writable, `out_smoothed`
+/// NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn sc_correspondence_working(
     correspondence: *const ScCorrespondence,
     side: u32,
     out_kind: *mut u32,
     out_vertices: *mut usize,
+    out_smoothed: *mut bool,
 ) -> ScStatus {
     boundary(|| {
         let c = handle(correspondence, "correspondence")?;
-        write_working(&c.result, side, out_kind, out_vertices)
+        write_working(&c.result, side, out_kind, out_vertices, out_smoothed)
     })
 }
 
 /// Writes side `side`'s working shape of `result` (`sc_correspondence_working`).
 ///
 /// # Safety
-/// `out_kind` and `out_vertices` must be NULL or writable.
+/// `out_kind`, `out_vertices` and `out_smoothed` must be NULL or writable.
 pub(crate) unsafe fn write_working(
     result: &Correspondence,
     side: u32,
     out_kind: *mut u32,
     out_vertices: *mut usize,
+    out_smoothed: *mut bool,
 ) -> FfiResult {
     let working = match side {
         SC_SIDE_A | SC_SIDE_B => result.working[side as usize],
@@ -527,6 +531,9 @@ pub(crate) unsafe fn write_working(
         WorkingKind::Refined => SC_WORKING_REFINED,
     };
     *vertices = working.vertices;
+    if let Some(smoothed) = out_smoothed.as_mut() {
+        *smoothed = working.smoothed;
+    }
     Ok(())
 }
 
@@ -660,9 +667,17 @@ mod tests {
                 ruled_out: vec![false; 2],
             }),
             estimate: None,
-            working: [(WorkingKind::Input, 300), (WorkingKind::Refined, 1200)].map(
-                |(kind, vertices)| crate::pipeline::multiresolution::Working { kind, vertices },
-            ),
+            working: [
+                (WorkingKind::Input, 300, true),
+                (WorkingKind::Refined, 1200, false),
+            ]
+            .map(|(kind, vertices, smoothed)| {
+                crate::pipeline::multiresolution::Working {
+                    kind,
+                    vertices,
+                    smoothed,
+                }
+            }),
         });
         std::sync::Arc::into_raw(std::sync::Arc::new(correspondence))
     }
@@ -772,30 +787,60 @@ mod tests {
     fn working_gives_each_sides_kind_and_size_and_checks_its_arguments() {
         let c = with_verdict(None);
         unsafe {
-            let (mut kind, mut vertices) = (99, 99);
-            let expected = [(SC_WORKING_INPUT, 300), (SC_WORKING_REFINED, 1200)];
+            let (mut kind, mut vertices, mut smoothed) = (99, 99, false);
+            let expected = [
+                (SC_WORKING_INPUT, 300, true),
+                (SC_WORKING_REFINED, 1200, false),
+            ];
             for (side, want) in [SC_SIDE_A, SC_SIDE_B].into_iter().zip(expected) {
-                let status = sc_correspondence_working(c, side, &mut kind, &mut vertices);
+                let status =
+                    sc_correspondence_working(c, side, &mut kind, &mut vertices, &mut smoothed);
                 assert_eq!(status, ScStatus::Ok);
-                assert_eq!((kind, vertices), want);
+                assert_eq!((kind, vertices, smoothed), want);
+                let status = sc_correspondence_working(
+                    c,
+                    side,
+                    &mut kind,
+                    &mut vertices,
+                    std::ptr::null_mut(),
+                );
+                assert_eq!(status, ScStatus::Ok, "out_smoothed may be NULL");
             }
             let (mut kind, mut vertices) = (99, 99);
             assert_eq!(
-                sc_correspondence_working(c, 2, &mut kind, &mut vertices),
+                sc_correspondence_working(c, 2, &mut kind, &mut vertices, &mut smoothed),
                 ScStatus::InvalidArgument
             );
             let message = CStr::from_ptr(super::super::sc_last_error());
             assert!(message.to_str().unwrap().contains("side"));
             assert_eq!(
-                sc_correspondence_working(c, SC_SIDE_A, std::ptr::null_mut(), &mut vertices),
+                sc_correspondence_working(
+                    c,
+                    SC_SIDE_A,
+                    std::ptr::null_mut(),
+                    &mut vertices,
+                    &mut smoothed
+                ),
                 ScStatus::NullArgument
             );
             assert_eq!(
-                sc_correspondence_working(c, SC_SIDE_A, &mut kind, std::ptr::null_mut()),
+                sc_correspondence_working(
+                    c,
+                    SC_SIDE_A,
+                    &mut kind,
+                    std::ptr::null_mut(),
+                    &mut smoothed
+                ),
                 ScStatus::NullArgument
             );
             assert_eq!(
-                sc_correspondence_working(std::ptr::null(), 0, &mut kind, &mut vertices),
+                sc_correspondence_working(
+                    std::ptr::null(),
+                    0,
+                    &mut kind,
+                    &mut vertices,
+                    &mut smoothed
+                ),
                 ScStatus::NullArgument
             );
             assert_eq!((kind, vertices), (99, 99), "nothing written on failure");

@@ -210,17 +210,25 @@ pub unsafe extern "C" fn sc_pointwise_regions(
 /// computed on the same working shapes as its regions).
 ///
 /// # Safety
-/// `pointwise` must be live; `out_kind` and `out_vertices` writable.
+/// `pointwise` must be live; `out_kind` and `out_vertices` writable, `out_smoothed` NULL
+/// or writable.
 #[no_mangle]
 pub unsafe extern "C" fn sc_pointwise_working(
     pointwise: *const ScPointwise,
     side: u32,
     out_kind: *mut u32,
     out_vertices: *mut usize,
+    out_smoothed: *mut bool,
 ) -> ScStatus {
     boundary(|| {
         let p = handle(pointwise, "pointwise")?;
-        write_working(&p.result.regions, side, out_kind, out_vertices)
+        write_working(
+            &p.result.regions,
+            side,
+            out_kind,
+            out_vertices,
+            out_smoothed,
+        )
     })
 }
 

@@ -23,6 +23,7 @@ use crate::pipeline::correspondence::Correspondence;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::neighbors::PointTree;
 use crate::shape::proxy::{Proxy, ProxyKind};
+use crate::shape::smoothing;
 use crate::shape::ShapeKind;
 use crate::shape::{distance, Shape};
 use crate::spectral::eigen::{check_max_vertices, EigenParams};
@@ -68,6 +69,9 @@ pub struct Working {
     pub kind: WorkingKind,
     /// Its active vertices.
     pub vertices: usize,
+    /// Whether its positions were smoothed because the input is a noisy mesh
+    /// ([`crate::shape::smoothing`]).
+    pub smoothed: bool,
 }
 
 /// What the pipeline ran on for one input shape.
@@ -93,13 +97,16 @@ impl Working {
             None => Working {
                 kind: WorkingKind::Input,
                 vertices: shape.active_vertices().len(),
+                smoothed: false,
             },
             Some(p) => Working {
                 kind: match p.kind {
                     ProxyKind::Simplified => WorkingKind::Proxy,
                     ProxyKind::Refined => WorkingKind::Refined,
+                    ProxyKind::Smoothed => WorkingKind::Input,
                 },
                 vertices: p.shape.active_vertices().len(),
+                smoothed: p.smoothed,
             },
         }
     }
@@ -180,7 +187,7 @@ impl Multiresolution {
         check_max_vertices(a, eigen).map_err(|e| e.in_shape('A'))?;
         check_max_vertices(b, eigen).map_err(|e| e.in_shape('B'))?;
         if !self.applies_to(a) && !self.applies_to(b) {
-            return Ok([None, None]);
+            return Ok([smoothed_if_noisy(a, None), smoothed_if_noisy(b, None)]);
         }
         polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
             let build = |shape: &Shape| -> Result<Option<Proxy>> {
@@ -192,13 +199,13 @@ impl Multiresolution {
                     Some(ProxyKind::Refined) => {
                         Proxy::refine_cancellable(shape, self.refine_below, cancel).map(Some)
                     }
-                    None => Ok(None),
+                    _ => Ok(None),
                 }
             };
             let proxy_a = build(a).map_err(|e| e.in_shape('A'))?;
             cancel.set_fraction(0.5);
             let proxy_b = build(b).map_err(|e| e.in_shape('B'))?;
-            Ok([proxy_a, proxy_b])
+            Ok([smoothed_if_noisy(a, proxy_a), smoothed_if_noisy(b, proxy_b)])
         })
     }
 }
@@ -206,11 +213,26 @@ impl Multiresolution {
 impl Multiresolution {
     /// The proxy of `shape` when it needs one.
     pub(crate) fn proxy(&self, shape: &Shape) -> Result<Option<Proxy>> {
-        match self.kind_for(shape) {
-            Some(ProxyKind::Simplified) => Proxy::build(shape, self.proxy_vertices).map(Some),
-            Some(ProxyKind::Refined) => Proxy::refine(shape, self.refine_below).map(Some),
-            None => Ok(None),
+        let proxy = match self.kind_for(shape) {
+            Some(ProxyKind::Simplified) => Some(Proxy::build(shape, self.proxy_vertices)?),
+            Some(ProxyKind::Refined) => Some(Proxy::refine(shape, self.refine_below)?),
+            _ => None,
+        };
+        Ok(smoothed_if_noisy(shape, proxy))
+    }
+}
+
+/// The working shape with scanner noise taken out when it is a noisy mesh
+/// ([`smoothing::is_noisy`]): a simplified proxy smoothed, or a smoothed copy of a shape that
+/// runs as it is. A refined copy of a low-poly mesh is left as it is (three quarters of its
+/// edges lie inside a flat input face, so the median angle does not see noise).
+fn smoothed_if_noisy(shape: &Shape, proxy: Option<Proxy>) -> Option<Proxy> {
+    match proxy {
+        Some(p) if p.kind == ProxyKind::Simplified && smoothing::is_noisy(&p.shape) => {
+            Some(p.into_smoothed())
         }
+        None if smoothing::is_noisy(shape) => Some(Proxy::smoothed_copy(shape)),
+        other => other,
     }
 }
 

@@ -105,6 +105,13 @@ pub fn local_delaunay_around(
         .collect()
 }
 
+/// The unit normal of a neighbourhood by PCA (the direction of least variance; its sign is
+/// arbitrary). None when the neighbourhood is a point.
+pub fn pca_normal(points: &[[f64; 3]], neighbors: &[(usize, f64)]) -> Option<[f64; 3]> {
+    let (u, v) = tangent_frame(points, neighbors)?;
+    Some(super::cross(&u, &v))
+}
+
 /// Two orthonormal tangent directions at a point from the covariance of its neighbours
 /// (the normal is the direction of least variance). None when the neighbourhood is a point.
 fn tangent_frame(points: &[[f64; 3]], neighbors: &[(usize, f64)]) -> Option<([f64; 3], [f64; 3])> {

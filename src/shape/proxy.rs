@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 use crate::progress::Cancel;
 use crate::shape::neighbors::PointTree;
+use crate::shape::smoothing::{self, TAUBIN_STEPS};
 use crate::shape::surface_point::{
     closest_on_triangle, heaviest_first, inverse_distance, SurfacePoint,
 };
@@ -36,6 +37,9 @@ pub struct Proxy {
     /// For every input vertex, where it lies on the proxy (on a refined proxy, exactly the
     /// proxy vertex it is).
     pub location: Vec<SurfacePoint>,
+    /// Whether its positions were smoothed because the input is noisy
+    /// ([`crate::shape::smoothing`]); its faces and where each vertex lies are unchanged.
+    pub smoothed: bool,
 }
 
 /// How a proxy was made from its input shape.
@@ -45,6 +49,9 @@ pub enum ProxyKind {
     Simplified,
     /// Every input vertex and triangle's midpoints (midpoint subdivision): a low-poly mesh.
     Refined,
+    /// The input's own vertices and faces, its positions smoothed: a noisy mesh
+    /// ([`Proxy::smoothed_copy`]).
+    Smoothed,
 }
 
 /// Proxy candidates checked per input vertex: the triangles around its nearest proxy
@@ -130,6 +137,7 @@ impl Proxy {
             shape: proxy_shape,
             origin: kept.into_iter().map(SurfacePoint::at).collect(),
             location,
+            smoothed: false,
         })
     }
 
@@ -227,7 +235,38 @@ impl Proxy {
             shape: refined,
             origin,
             location,
+            smoothed: false,
         })
+    }
+}
+
+impl Proxy {
+    /// A copy of mesh `shape` with its positions smoothed ([`smoothing::taubin_smoothed`]):
+    /// every vertex is itself, so the answers come back unchanged.
+    pub fn smoothed_copy(shape: &Shape) -> Proxy {
+        let copy = shape.with_moved_vertices(smoothing::taubin_smoothed(shape, TAUBIN_STEPS));
+        let representative = shape.representative();
+        Proxy {
+            kind: ProxyKind::Smoothed,
+            shape: copy,
+            origin: (0..shape.n_vertices() as u32)
+                .map(SurfacePoint::at)
+                .collect(),
+            location: (0..shape.n_vertices())
+                .map(|v| SurfacePoint::at(representative[v]))
+                .collect(),
+            smoothed: true,
+        }
+    }
+
+    /// This proxy with its positions smoothed ([`smoothing::taubin_smoothed`]).
+    pub fn into_smoothed(self) -> Proxy {
+        let moved = smoothing::taubin_smoothed(&self.shape, TAUBIN_STEPS);
+        Proxy {
+            shape: self.shape.with_moved_vertices(moved),
+            smoothed: true,
+            ..self
+        }
     }
 }
 

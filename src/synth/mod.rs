@@ -60,7 +60,7 @@ use geom::V3;
 
 pub use pieces::{cut_into_pieces, PiecesMesh};
 pub use props::box_beside;
-pub use sampling::{sample_points, SampledCloud};
+pub use sampling::{sample_points, with_noise, SampledCloud};
 
 /// The kinds of figure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -117,3 +117,20 @@ pub(crate) fn bounding_box_diagonal(points: &[V3]) -> f64 {
     let (lo, hi) = crate::shape::bounding_box(points);
     dist(lo, hi).max(0.0)
 }
+
+/// Every point moved by an isotropic Gaussian whose root mean square is `level` times the
+/// diagonal of the points' bounding box (scanner noise, docs/scans.md). Deterministic for a
+/// given `seed`.
+pub fn with_noise(points: &[[f64; 3]], level: f64, seed: u64) -> Vec<[f64; 3]> {
+    let sigma = level * crate::shape::bounding_box_diagonal(points) / 3f64.sqrt();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    points
+        .iter()
+        .map(|p| {
+            p.map(|x| {
+                let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+                x + sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+            })
+        })
+        .collect()
+}

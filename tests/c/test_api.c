@@ -373,11 +373,15 @@ static void check_confidence(const char *what, double confidence, const char *wa
 
 /* What the pipeline ran on for one side of `c` whose input has `n` vertices: the input
  * itself from 2,000 vertices (option `refine_below`), else a refined copy with more
- * vertices; the bad side and NULL arguments fail and write nothing. */
+ * vertices, never smoothed (a generated figure has no noise); the bad side and NULL
+ * arguments fail and write nothing. */
 static void check_working(const sc_correspondence *c, uint32_t side, size_t n) {
     uint32_t kind = 99;
     size_t vertices = 0;
-    CHECK_STATUS(sc_correspondence_working(c, side, &kind, &vertices), SC_STATUS_OK);
+    bool smoothed = true;
+    CHECK_STATUS(sc_correspondence_working(c, side, &kind, &vertices, &smoothed), SC_STATUS_OK);
+    CHECK(!smoothed, "side %u: a clean figure is not smoothed", side);
+    CHECK_STATUS(sc_correspondence_working(c, side, &kind, &vertices, NULL), SC_STATUS_OK);
     if (n >= 2000)
         CHECK(kind == SC_WORKING_INPUT && vertices == n, "side %u of %zu vertices: kind %u, %zu",
               side, n, kind, vertices);
@@ -386,11 +390,15 @@ static void check_working(const sc_correspondence *c, uint32_t side, size_t n) {
               "side %u of %zu vertices: kind %u, %zu", side, n, kind, vertices);
     kind = 99;
     vertices = 0;
-    CHECK_STATUS(sc_correspondence_working(c, 2, &kind, &vertices), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_working(c, 2, &kind, &vertices, &smoothed),
+                 SC_STATUS_INVALID_ARGUMENT);
     CHECK(strstr(sc_last_error(), "side") != NULL, "message: %s", sc_last_error());
-    CHECK_STATUS(sc_correspondence_working(c, side, NULL, &vertices), SC_STATUS_NULL_ARGUMENT);
-    CHECK_STATUS(sc_correspondence_working(c, side, &kind, NULL), SC_STATUS_NULL_ARGUMENT);
-    CHECK_STATUS(sc_correspondence_working(NULL, side, &kind, &vertices), SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_working(c, side, NULL, &vertices, &smoothed),
+                 SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_working(c, side, &kind, NULL, &smoothed),
+                 SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_working(NULL, side, &kind, &vertices, &smoothed),
+                 SC_STATUS_NULL_ARGUMENT);
     CHECK(kind == 99 && vertices == 0, "nothing written on failure");
 }
 
@@ -941,7 +949,7 @@ static void test_pointwise_permuted_copy(void) {
         /* The map is brought back to the input vertices last when it ran on a copy. */
         uint32_t kind = 99;
         size_t vertices = 0;
-        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, &kind, &vertices), SC_STATUS_OK);
+        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, &kind, &vertices, NULL), SC_STATUS_OK);
         CHECK(log.last_stage ==
                   (kind == SC_WORKING_INPUT ? SC_STAGE_POINTWISE_MAP : SC_STAGE_PROXY),
               "last stage %u, working kind %u", log.last_stage, kind);
@@ -1013,19 +1021,23 @@ static void test_pointwise_permuted_copy(void) {
         /* The map ran on the working shapes of its regions. */
         uint32_t kind = 99, regions_kind = 98;
         size_t vertices = 0, regions_vertices = 1;
-        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_B, &kind, &vertices), SC_STATUS_OK);
-        CHECK_STATUS(sc_correspondence_working(regions, SC_SIDE_B, &regions_kind,
-                                               &regions_vertices),
+        bool smoothed = true, regions_smoothed = false;
+        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_B, &kind, &vertices, &smoothed),
                      SC_STATUS_OK);
-        CHECK(kind == regions_kind && vertices == regions_vertices,
+        CHECK_STATUS(sc_correspondence_working(regions, SC_SIDE_B, &regions_kind,
+                                               &regions_vertices, &regions_smoothed),
+                     SC_STATUS_OK);
+        CHECK(kind == regions_kind && vertices == regions_vertices &&
+                  smoothed == regions_smoothed,
               "pointwise working %u of %zu, its regions' %u of %zu", kind, vertices,
               regions_kind, regions_vertices);
         CHECK(kind == (n < 2000 ? SC_WORKING_REFINED : SC_WORKING_INPUT), "kind %u for %zu", kind,
               n);
-        CHECK_STATUS(sc_pointwise_working(p, 2, &kind, &vertices), SC_STATUS_INVALID_ARGUMENT);
-        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, NULL, &vertices),
+        CHECK_STATUS(sc_pointwise_working(p, 2, &kind, &vertices, NULL),
+                     SC_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, NULL, &vertices, NULL),
                      SC_STATUS_NULL_ARGUMENT);
-        CHECK_STATUS(sc_pointwise_working(NULL, SC_SIDE_A, &kind, &vertices),
+        CHECK_STATUS(sc_pointwise_working(NULL, SC_SIDE_A, &kind, &vertices, NULL),
                      SC_STATUS_NULL_ARGUMENT);
     }
 

@@ -813,13 +813,16 @@ _WORKING_KINDS: dict[int, WorkingKind] = {
 class Working(NamedTuple):
     """What the pipeline ran on for one side (:attr:`Correspondence.working`): the input
     itself, a simplified proxy of a dense shape (options ``proxy_above``,
-    ``proxy_vertices``) or a refined copy of a low-poly mesh (``refine_below``). The answers
-    are given on every input vertex whatever it ran on."""
+    ``proxy_vertices``) or a refined copy of a low-poly mesh (``refine_below``), its
+    positions smoothed when the input is a noisy mesh (scanner noise). The answers are given
+    on every input vertex whatever it ran on."""
 
     #: ``"input"``, ``"proxy"`` or ``"refined"``.
     kind: WorkingKind
     #: Its vertices (the input's active ones for ``"input"``).
     vertices: int
+    #: Whether its positions were smoothed because the input is a noisy mesh.
+    smoothed: bool = False
 
 
 def _working(function, result) -> tuple[Working, Working]:
@@ -827,9 +830,9 @@ def _working(function, result) -> tuple[Working, Working]:
     ``sc_pointwise_working``."""
     sides = []
     for side in (_lib.SIDE_A, _lib.SIDE_B):
-        kind, vertices = ctypes.c_uint32(), ctypes.c_size_t()
-        _check(function(result, side, ctypes.byref(kind), ctypes.byref(vertices)))
-        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value))
+        kind, vertices, smoothed = ctypes.c_uint32(), ctypes.c_size_t(), ctypes.c_bool()
+        _check(function(result, side, ctypes.byref(kind), ctypes.byref(vertices), ctypes.byref(smoothed)))
+        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value, smoothed.value))
     return sides[0], sides[1]
 
 

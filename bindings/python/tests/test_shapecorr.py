@@ -377,13 +377,27 @@ def test_working_says_input_proxy_or_refined(humanoids):
     working_a, working_b = result.working
     assert isinstance(working_a, shapecorr.Working)
     assert working_a.kind == "refined" and working_a.vertices > low.n_vertices, working_a
-    assert working_b == ("input", b.n_vertices)
+    assert working_b == ("input", b.n_vertices, False)
     assert shapecorr.match(a, b, verify_hypotheses=False).working == (
-        ("input", a.n_vertices), ("input", b.n_vertices),
+        ("input", a.n_vertices, False), ("input", b.n_vertices, False),
     )
     dense = shapecorr.match(a, b, verify_hypotheses=False, proxy_above=2000, proxy_vertices=1000)
     assert [w.kind for w in dense.working] == ["proxy", "proxy"]
     assert all(w.vertices < 2000 for w in dense.working), dense.working
+
+
+def test_a_noisy_mesh_is_matched_on_a_smoothed_copy(humanoids):
+    """Vertex noise of about 1% of the diagonal: B runs on a smoothed copy of its own
+    vertices, said in ``working``; the answer stays on B's vertices and close to the clean
+    pair's."""
+    a, b = humanoids
+    diagonal = float(np.linalg.norm(b.vertices.max(0) - b.vertices.min(0)))
+    rng = np.random.default_rng(3)
+    noisy = shapecorr.Shape.mesh(b.vertices + rng.normal(0, 0.01 * diagonal / 3**0.5, (b.n_vertices, 3)), b.triangles)
+    result = shapecorr.match(a, noisy, verify_hypotheses=False)
+    assert result.working == (("input", a.n_vertices, False), ("input", b.n_vertices, True))
+    clean = shapecorr.match(a, b, verify_hypotheses=False)
+    assert symmetric_accuracy(result, result.matches) >= 0.8 * symmetric_accuracy(clean, clean.matches)
 
 
 def test_working_raw_api_errors(humanoids):
@@ -392,10 +406,10 @@ def test_working_raw_api_errors(humanoids):
     lib = _lib.lib
     kind, vertices = ctypes.c_uint32(7), ctypes.c_size_t(7)
     names = _lib.STATUS_NAMES
-    assert names[lib.sc_correspondence_working(result, 2, ctypes.byref(kind), ctypes.byref(vertices))] == "INVALID_ARGUMENT"
-    assert names[lib.sc_correspondence_working(result, 0, None, ctypes.byref(vertices))] == "NULL_ARGUMENT"
-    assert names[lib.sc_correspondence_working(None, 0, ctypes.byref(kind), ctypes.byref(vertices))] == "NULL_ARGUMENT"
-    assert names[lib.sc_pointwise_working(None, 0, ctypes.byref(kind), ctypes.byref(vertices))] == "NULL_ARGUMENT"
+    assert names[lib.sc_correspondence_working(result, 2, ctypes.byref(kind), ctypes.byref(vertices), None)] == "INVALID_ARGUMENT"
+    assert names[lib.sc_correspondence_working(result, 0, None, ctypes.byref(vertices), None)] == "NULL_ARGUMENT"
+    assert names[lib.sc_correspondence_working(None, 0, ctypes.byref(kind), ctypes.byref(vertices), None)] == "NULL_ARGUMENT"
+    assert names[lib.sc_pointwise_working(None, 0, ctypes.byref(kind), ctypes.byref(vertices), None)] == "NULL_ARGUMENT"
     assert (kind.value, vertices.value) == (7, 7), "nothing written on failure"
 
 
@@ -503,7 +517,7 @@ def test_permuted_copy_is_mapped_back(humanoids):
     assert stages[-1][0] == "pointwise_map" and all(0.0 <= f <= 1.0 for _, f in stages)
     assert {s for s, _ in stages} >= {"eigenbasis", "segmentation", "matching", "pointwise_map"}
     assert (result.n_vertices_a, result.n_vertices_b) == (a.n_vertices, b.n_vertices)
-    assert result.working == (("input", a.n_vertices), ("input", b.n_vertices))
+    assert result.working == (("input", a.n_vertices, False), ("input", b.n_vertices, False))
     assert result.working == result.regions.working
     mapped = result.map_b_to_a
     assert mapped.dtype == np.uint32 and mapped.shape == (b.n_vertices,)

@@ -2,10 +2,13 @@
 //! given, with Gaussian vertex noise (an isotropic displacement whose root mean square is
 //! 0.25%, 0.5% and 1% of B's bounding-box diagonal), with a box a tenth of B's height
 //! standing beside its lowest foot (touching it, and 3% of the height apart), and as a point
-//! cloud (B's vertices jittered by 0.2% of its height; A as a mesh and as a cloud). Each B
+//! cloud (B's vertices jittered by 0.2% of its height; A as a mesh and as a cloud), and the
+//! clean pair without the orientation terms ("clean unoriented": what a cloud lost before
+//! it had an orientation). Each B
 //! is mapped to A by the default pipeline (`p2p`) and scored on B's own vertices against
 //! the dataset's truth (mean geodesic error over sqrt(area) on A, a left/right flip allowed
-//! for clouds, a pair failed above 0.1). Prints a line per pair and variant (error,
+//! for clouds, a pair failed above 0.1; each cloud line also gives the error without the
+//! flip and whether each cloud's orientation was trusted). Prints a line per pair and variant (error,
 //! confidence, what the repairs said of the box) and a summary per variant: mean, median,
 //! worst, failed, and the ratio of the mean to the clean mean.
 //!
@@ -31,8 +34,9 @@ const SAMPLES: usize = 1_000;
 /// FAUST_r shape's (the scans issue's box held 12% of the vertices).
 const BOX_GRID: usize = 12;
 /// The variants, in the order they run.
-const VARIANTS: [&str; 9] = [
+const VARIANTS: [&str; 10] = [
     "clean",
+    "clean unoriented",
     "noise 0.25%",
     "noise 0.5%",
     "noise 1%",
@@ -121,16 +125,19 @@ fn one(
         Shape::point_cloud(jittered(s.vertices(), 0.002 * height(s.vertices()), seed))
     };
     let (a_used, b_used) = match variant {
-        "clean" => (a.clone(), b.clone()),
+        "clean" | "clean unoriented" => (a.clone(), b.clone()),
         "noise 0.25%" => (
             a.clone(),
-            b.with_vertices(noisy(b.vertices(), 0.0025, seed))?,
+            b.with_vertices(synth::with_noise(b.vertices(), 0.0025, seed))?,
         ),
         "noise 0.5%" => (
             a.clone(),
-            b.with_vertices(noisy(b.vertices(), 0.005, seed))?,
+            b.with_vertices(synth::with_noise(b.vertices(), 0.005, seed))?,
         ),
-        "noise 1%" => (a.clone(), b.with_vertices(noisy(b.vertices(), 0.01, seed))?),
+        "noise 1%" => (
+            a.clone(),
+            b.with_vertices(synth::with_noise(b.vertices(), 0.01, seed))?,
+        ),
         "box touching" => (a.clone(), with_box(b, 0.0)?),
         "box apart" => (a.clone(), with_box(b, 0.03)?),
         "mesh to cloud" => (a.clone(), cloud(b, seed)?),
@@ -138,11 +145,16 @@ fn one(
         "cloud to mesh" => (cloud(a, seed ^ 1)?, b.clone()),
         other => panic!("unknown variant {other}"),
     };
+    let mut pointwise = PointwiseParams::default();
+    if variant == "clean unoriented" {
+        pointwise.orientation = false;
+        pointwise.orientation_term = 0.0;
+    }
     let result = PointwiseCorrespondence::compute(
         &a_used,
         &b_used,
         &Default::default(),
-        &PointwiseParams::default(),
+        &pointwise,
         &mut NoProgress,
     )?;
     let map: Vec<u32> = result.map.p2p_ba[..n_b].to_vec();
@@ -152,7 +164,20 @@ fn one(
         (Some(m), true) => scores[0].error.mean.min(m.mean),
         _ => scores[0].error.mean,
     };
-    let notes: Vec<String> = b_used.warnings().iter().map(|w| w.to_string()).collect();
+    let mut notes: Vec<String> = b_used.warnings().iter().map(|w| w.to_string()).collect();
+    if flip_allowed {
+        let oriented = |s: &Shape| match s.kind() {
+            shapecorr::ShapeKind::PointCloud if s.oriented_triangles().is_some() => "oriented",
+            shapecorr::ShapeKind::PointCloud => "not oriented",
+            _ => "mesh",
+        };
+        notes.push(format!(
+            "without the flip {:.4}; A {}, B {}",
+            scores[0].error.mean,
+            oriented(&a_used),
+            oriented(&b_used)
+        ));
+    }
     println!(
         "{} -> {} {variant}: {error:.4} confidence {} {}",
         pair.source,
@@ -185,13 +210,6 @@ fn height(points: &[[f64; 3]]) -> f64 {
 fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
     (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-}
-
-/// Every point moved by an isotropic Gaussian of root mean square `level` x the diagonal.
-fn noisy(points: &[[f64; 3]], level: f64, seed: u64) -> Vec<[f64; 3]> {
-    let (lo, hi) = bounds(points);
-    let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
-    jittered(points, level * diagonal / 3f64.sqrt(), seed)
 }
 
 /// Every coordinate moved by a Gaussian of deviation `sigma`.
