@@ -14,6 +14,11 @@ use shapecorr::{ReadAs, Shape};
 fn main() -> shapecorr::Result<()> {
     for file in std::env::args().skip(1) {
         let mesh = Shape::read(std::path::Path::new(&file), ReadAs::Auto)?;
+        if mesh.kind() == shapecorr::ShapeKind::PointCloud {
+            let cloud = orient(mesh.vertices());
+            println!("{file} (a cloud): agreement {:.3}", cloud.agreement);
+            continue;
+        }
         let Some(faces) = mesh.oriented_triangles() else {
             continue;
         };
