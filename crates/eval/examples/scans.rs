@@ -34,7 +34,7 @@ const SAMPLES: usize = 1_000;
 /// FAUST_r shape's (the scans issue's box held 12% of the vertices).
 const BOX_GRID: usize = 12;
 /// The variants, in the order they run.
-const VARIANTS: [&str; 10] = [
+const VARIANTS: [&str; 12] = [
     "clean",
     "clean unoriented",
     "noise 0.25%",
@@ -45,6 +45,8 @@ const VARIANTS: [&str; 10] = [
     "mesh to cloud",
     "cloud to cloud",
     "cloud to mesh",
+    "mesh points to cloud",
+    "mesh points to mesh points",
 ];
 
 fn main() -> shapecorr::Result<()> {
@@ -143,6 +145,11 @@ fn one(
         "mesh to cloud" => (a.clone(), cloud(b, seed)?),
         "cloud to cloud" => (cloud(a, seed ^ 1)?, cloud(b, seed)?),
         "cloud to mesh" => (cloud(a, seed ^ 1)?, b.clone()),
+        "mesh points to cloud" => (Shape::point_cloud(a.vertices().to_vec())?, cloud(b, seed)?),
+        "mesh points to mesh points" => (
+            Shape::point_cloud(a.vertices().to_vec())?,
+            Shape::point_cloud(b.vertices().to_vec())?,
+        ),
         other => panic!("unknown variant {other}"),
     };
     let mut pointwise = PointwiseParams::default();
@@ -159,7 +166,7 @@ fn one(
     )?;
     let map: Vec<u32> = result.map.p2p_ba[..n_b].to_vec();
     let scores = score_maps(store, pair, &[(variant.to_string(), map, 0.0)], SAMPLES)?;
-    let flip_allowed = variant.contains("cloud");
+    let flip_allowed = variant.contains("cloud") || variant.contains("points");
     let error = match (&scores[0].error_mirrored, flip_allowed) {
         (Some(m), true) => scores[0].error.mean.min(m.mean),
         _ => scores[0].error.mean,
