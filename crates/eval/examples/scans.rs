@@ -2,18 +2,19 @@
 //! given, with Gaussian vertex noise (an isotropic displacement whose root mean square is
 //! 0.25%, 0.5% and 1% of B's bounding-box diagonal), with a box a tenth of B's height
 //! standing beside its lowest foot (touching it, and 3% of the height apart), and as a point
-//! cloud (B's vertices jittered by 0.2% of its height; A as a mesh and as a cloud), and the
-//! clean pair without the orientation terms ("clean unoriented": what a cloud lost before
-//! it had an orientation). Each B
-//! is mapped to A by the default pipeline (`p2p`) and scored on B's own vertices against
-//! the dataset's truth (mean geodesic error over sqrt(area) on A, a left/right flip allowed
-//! for clouds, a pair failed above 0.1; each cloud line also gives the error without the
-//! flip and whether each cloud's orientation was trusted). Prints a line per pair and variant (error,
-//! confidence, what the repairs said of the box) and a summary per variant: mean, median,
-//! worst, failed, and the ratio of the mean to the clean mean.
+//! cloud (B's vertices jittered by 0.2% of its height; A as a mesh and as a cloud; or the
+//! mesh's own vertices as a cloud, no jitter: "mesh points"), and the clean pair without the
+//! orientation terms ("clean unoriented": what a cloud lacks). Each B is mapped to A by the
+//! default pipeline (`p2p`) and scored on B's own vertices against the dataset's truth (mean
+//! geodesic error over sqrt(area) on A, a left/right flip allowed for clouds, a pair failed
+//! above 0.1; each cloud line also gives the error without the flip). Prints a line per pair
+//! and variant (error, confidence, the chosen hypothesis, what decided it and its turn, every
+//! hypothesis's cost and turn, what the repairs said) and a summary per variant: mean,
+//! median, worst, failed, and the ratio of the mean to the clean mean. `--source NAME` keeps
+//! the selected pairs whose A is NAME.
 //!
 //!     cargo run --release -p shapecorr-eval --example scans -- \
-//!         [--data DIR] [--limit N] [--only VARIANT,..] DATASET
+//!         [--data DIR] [--limit N] [--only VARIANT,..] [--source NAME] DATASET
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -52,7 +53,7 @@ const VARIANTS: [&str; 12] = [
 fn main() -> shapecorr::Result<()> {
     let mut args = std::env::args().skip(1);
     let (mut data, mut limit, mut only) = (default_data_root(), None::<usize>, None::<Vec<String>>);
-    let mut name = None;
+    let (mut name, mut source) = (None, None::<String>);
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--data" => data = PathBuf::from(args.next().expect("--data DIR")),
@@ -62,6 +63,7 @@ fn main() -> shapecorr::Result<()> {
                     .next()
                     .map(|list| list.split(',').map(str::to_string).collect())
             }
+            "--source" => source = args.next(),
             dataset => name = Some(dataset.to_string()),
         }
     }
@@ -71,6 +73,9 @@ fn main() -> shapecorr::Result<()> {
         Some(n) if n < pairs.len() => (0..n).map(|i| pairs[i * pairs.len() / n].clone()).collect(),
         _ => pairs,
     };
+    let pairs: Vec<Pair> = (pairs.into_iter())
+        .filter(|p| source.as_ref().is_none_or(|s| *s == p.source))
+        .collect();
     let variants: Vec<&str> = VARIANTS
         .into_iter()
         .filter(|v| only.as_ref().is_none_or(|o| o.iter().any(|x| x == v)))
@@ -185,8 +190,28 @@ fn one(
             oriented(&b_used)
         ));
     }
+    let verdict = result.verdict().map_or(String::new(), |v| {
+        let chosen = v.chosen();
+        let others: Vec<String> = (v.scores.iter())
+            .map(|s| {
+                format!(
+                    "{} {:.3} {:.0}",
+                    s.kind.name(),
+                    s.energy.cost(),
+                    s.turn_degrees
+                )
+            })
+            .collect();
+        format!(
+            "{} by {}, turn {:.0} degrees [{}]; ",
+            chosen.kind.name(),
+            v.decided_by.name(),
+            chosen.turn_degrees,
+            others.join(", ")
+        )
+    });
     println!(
-        "{} -> {} {variant}: {error:.4} confidence {} {}",
+        "{} -> {} {variant}: {error:.4} confidence {} {verdict}{}",
         pair.source,
         pair.target,
         result
