@@ -25,7 +25,8 @@ use crate::shape::{Shape, ShapeKind};
 use crate::{Error, Result};
 
 /// Images further than this many mean edges of A from a vertex's own image are left out of
-/// its mean (the map tears between them). Not tuned: as the proxies' lifting ([`crate::pipeline::multiresolution`]).
+/// its mean (the map tears between them). Not tuned: as the proxies' lifting (docs/design.md,
+/// step 16).
 const TEAR_EDGES: f64 = 3.0;
 
 /// Neighbours of a point of a point cloud B whose images are averaged (a mesh vertex has

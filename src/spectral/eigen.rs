@@ -272,7 +272,7 @@ fn check_size(shape: &Shape, params: &EigenParams) -> Result<()> {
 }
 
 /// Refuses a shape above [`EigenParams::max_vertices`] with [`Error::ResourceLimit`] (also
-/// checked on a dense input before its proxy is built, [`crate::multiresolution`]).
+/// checked on a dense input before its proxy is built: docs/design.md, step 16).
 pub(crate) fn check_max_vertices(shape: &Shape, params: &EigenParams) -> Result<()> {
     let n = shape.active_vertices().len();
     if n > params.max_vertices {
