@@ -618,6 +618,21 @@ sc_status sc_correspondence_working(const sc_correspondence *correspondence,
                                     size_t *out_vertices,
                                     bool *out_smoothed);
 
+// The objects touching one side's figure (`SC_SIDE_A` or `SC_SIDE_B`) that the pair job
+// left out because the pair matched better without them (a prop touching a foot,
+// docs/scans.md, "Props"): `out_pieces` gets their number of pieces and `out_vertices`
+// (NULL: not asked) their vertices, which take the answer of the nearest kept vertex;
+// both 0 when nothing was left out. Nothing is written on error.
+//
+// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
+//
+// # Safety
+// `correspondence` must be live; `out_pieces` writable, `out_vertices` NULL or writable.
+sc_status sc_correspondence_objects_left_out(const sc_correspondence *correspondence,
+                                             uint32_t side,
+                                             size_t *out_pieces,
+                                             size_t *out_vertices);
+
 // What settled the choice among the hypotheses (static; never free it): `"cost"` (the
 // cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
 // stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
@@ -840,6 +855,16 @@ sc_status sc_pointwise_fmap(const sc_pointwise *pointwise, double *out_fmap, siz
 // `pointwise` must be live; `out_correspondence` writable.
 sc_status sc_pointwise_regions(const sc_pointwise *pointwise,
                                sc_correspondence **out_correspondence);
+
+// The objects touching one side's figure that the pair job left out, as
+// `sc_correspondence_objects_left_out`.
+//
+// # Safety
+// `pointwise` must be live; `out_pieces` writable, `out_vertices` NULL or writable.
+sc_status sc_pointwise_objects_left_out(const sc_pointwise *pointwise,
+                                        uint32_t side,
+                                        size_t *out_pieces,
+                                        size_t *out_vertices);
 
 // What the pipeline ran on for one side, as `sc_correspondence_working` (the map was
 // computed on the same working shapes as its regions).

@@ -143,13 +143,17 @@ def working_lines(result, shapes=()):
     """``A was matched on a refined copy of 1,204 vertices (the input has 290)`` (or ``a
     proxy of``) for each side the library ran on a refined copy of a low-poly mesh or a proxy
     of a dense one (``result.working``), ``A looks noisy ...`` for one matched on a smoothed
-    copy of a noisy mesh; nothing for a side matched on its input as it is."""
+    copy of a noisy mesh, ``A: 866 vertices of an object touching the figure ... left out``
+    for a prop the pair job left out; nothing for a side matched on its input as it is."""
     lines = []
     for index, shape in enumerate(getattr(result, "working", ())):
         kind, vertices, smoothed = shape[0], shape[1], getattr(shape, "smoothed", False)
+        side = "ab"[index]
+        left_out = getattr(shape, "objects_left_out", 0)
+        if left_out:
+            lines.append(f"{side.upper()}: {left_out:,} vertices of an object touching the figure (a prop) were left out: the pair matched better without them; they take the answer of the nearest kept vertex")
         if kind == "input" and not smoothed:
             continue
-        side = "ab"[index]
         if kind == "input":
             lines.append(f"{side.upper()} looks noisy (scanner noise): it was matched on a smoothed copy; the answers are on its own vertices")
             continue

@@ -135,13 +135,17 @@ def repair_notes(names, shapes):
 def working_notes(names, result):
     """One report line per object that the library matched on a proxy (a dense mesh), a
     refined copy (a low-poly mesh) or a smoothed copy (a noisy mesh) rather than on its input
-    as it is (``result.working``); none for results that do not say (symmetry)."""
+    as it is, or with an object touching it left out (``result.working``); none for results
+    that do not say (symmetry)."""
     working = getattr(result, "working", None)
     if working is None:
         return []
     notes = []
     for name, side, shape in zip(names, "ab", working):
         kind, vertices, smoothed = shape[0], shape[1], getattr(shape, "smoothed", False)
+        left_out = getattr(shape, "objects_left_out", 0)
+        if left_out:
+            notes.append(f"shapecorr: '{name}': {left_out:,} vertices of an object touching the figure (a prop) were left out: the pair matched better without them; they take the answer of the nearest kept vertex")
         if kind == "input" and not smoothed:
             continue
         if kind == "input":

@@ -272,6 +272,19 @@ def test_the_report_says_a_noisy_object_was_smoothed(addon):
     ]
 
 
+def test_the_report_says_an_object_touching_the_figure_was_left_out(addon):
+    from types import SimpleNamespace
+
+    Working = addon.shapecorr.Working
+    result = SimpleNamespace(
+        n_vertices_a=5000, n_vertices_b=5866,
+        working=(Working("input", 5000), Working("input", 5000, False, 866)),
+    )
+    assert addon.operators.working_notes(["Body", "Body and box"], result) == [
+        "shapecorr: 'Body and box': 866 vertices of an object touching the figure (a prop) were left out: the pair matched better without them; they take the answer of the nearest kept vertex",
+    ]
+
+
 def test_undo_removes_the_attributes(addon):
     operator = addon.operators.SHAPECORR_OT_match_regions
     assert {"REGISTER", "UNDO"} <= operator.bl_options

@@ -342,6 +342,19 @@ def test_the_report_says_a_noisy_side_was_smoothed():
     ]
 
 
+def test_the_report_says_an_object_touching_the_figure_was_left_out():
+    from types import SimpleNamespace
+
+    prop = SimpleNamespace(
+        confidence=None, warning=None, hypothesis=None, n_vertices_a=5000, n_vertices_b=5866,
+        working=(shapecorr.Working("input", 5000), shapecorr.Working("input", 5000, False, 866)),
+    )
+    assert shapecorr_meshlab.report(prop) == [
+        "not verified",
+        "B: 866 vertices of an object touching the figure (a prop) were left out: the pair matched better without them; they take the answer of the nearest kept vertex",
+    ]
+
+
 def test_the_report_says_how_the_answer_was_chosen_and_what_to_do():
     from types import SimpleNamespace
 

@@ -10,7 +10,7 @@ use super::params::{params_or_default, ScParams};
 use super::shape::ScShape;
 use super::verdict::{self, VerdictText};
 use super::{CallbackProgress, ScProgressCallback};
-use crate::pipeline::multiresolution::WorkingKind;
+use crate::pipeline::multiresolution::{Working, WorkingKind};
 use crate::pipeline::Correspondence;
 use crate::regions::graph::ShapeGraph;
 
@@ -502,6 +502,16 @@ pub unsafe extern "C" fn sc_correspondence_working(
     })
 }
 
+/// Side `side`'s working shape of `result`; a side other than A or B is an invalid argument.
+fn working_of(result: &Correspondence, side: u32) -> FfiResult<Working> {
+    match side {
+        SC_SIDE_A | SC_SIDE_B => Ok(result.working[side as usize]),
+        _ => Err(Failure::invalid(format!(
+            "side must be SC_SIDE_A (0) or SC_SIDE_B (1), got {side}"
+        ))),
+    }
+}
+
 /// Writes side `side`'s working shape of `result` (`sc_correspondence_working`).
 ///
 /// # Safety
@@ -513,14 +523,7 @@ pub(crate) unsafe fn write_working(
     out_vertices: *mut usize,
     out_smoothed: *mut bool,
 ) -> FfiResult {
-    let working = match side {
-        SC_SIDE_A | SC_SIDE_B => result.working[side as usize],
-        _ => {
-            return Err(Failure::invalid(format!(
-                "side must be SC_SIDE_A (0) or SC_SIDE_B (1), got {side}"
-            )))
-        }
-    };
+    let working = working_of(result, side)?;
     let kind = out_kind.as_mut().ok_or_else(|| Failure::null("out_kind"))?;
     let vertices = out_vertices
         .as_mut()
@@ -533,6 +536,50 @@ pub(crate) unsafe fn write_working(
     *vertices = working.vertices;
     if let Some(smoothed) = out_smoothed.as_mut() {
         *smoothed = working.smoothed;
+    }
+    Ok(())
+}
+
+/// The objects touching one side's figure (`SC_SIDE_A` or `SC_SIDE_B`) that the pair job
+/// left out because the pair matched better without them (a prop touching a foot,
+/// docs/scans.md, "Props"): `out_pieces` gets their number of pieces and `out_vertices`
+/// (NULL: not asked) their vertices, which take the answer of the nearest kept vertex;
+/// both 0 when nothing was left out. Nothing is written on error.
+///
+/// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
+///
+/// # Safety
+/// `correspondence` must be live; `out_pieces` writable, `out_vertices` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_objects_left_out(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_pieces: *mut usize,
+    out_vertices: *mut usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        write_objects_left_out(&c.result, side, out_pieces, out_vertices)
+    })
+}
+
+/// Writes side `side`'s objects left out of `result` (`sc_correspondence_objects_left_out`).
+///
+/// # Safety
+/// `out_pieces` and `out_vertices` must be NULL or writable.
+pub(crate) unsafe fn write_objects_left_out(
+    result: &Correspondence,
+    side: u32,
+    out_pieces: *mut usize,
+    out_vertices: *mut usize,
+) -> FfiResult {
+    let working = working_of(result, side)?;
+    let pieces = out_pieces
+        .as_mut()
+        .ok_or_else(|| Failure::null("out_pieces"))?;
+    *pieces = working.objects_left_out.pieces;
+    if let Some(vertices) = out_vertices.as_mut() {
+        *vertices = working.objects_left_out.vertices;
     }
     Ok(())
 }
@@ -676,6 +723,10 @@ mod tests {
                     kind,
                     vertices,
                     smoothed,
+                    objects_left_out: crate::shape::ObjectsLeftOut {
+                        pieces: usize::from(kind == WorkingKind::Refined),
+                        vertices: 40 * usize::from(kind == WorkingKind::Refined),
+                    },
                 }
             }),
         });
@@ -780,6 +831,36 @@ mod tests {
             assert!(sc_correspondence_warning(std::ptr::null()).is_null());
             let message = CStr::from_ptr(super::super::sc_last_error());
             assert!(message.to_str().unwrap().contains("correspondence"));
+        }
+    }
+
+    #[test]
+    fn objects_left_out_gives_each_sides_count_and_checks_its_arguments() {
+        let c = with_verdict(None);
+        unsafe {
+            let (mut pieces, mut vertices) = (99, 99);
+            for (side, want) in [(SC_SIDE_A, (0, 0)), (SC_SIDE_B, (1, 40))] {
+                let status =
+                    sc_correspondence_objects_left_out(c, side, &mut pieces, &mut vertices);
+                assert_eq!(status, ScStatus::Ok);
+                assert_eq!((pieces, vertices), want);
+                let status =
+                    sc_correspondence_objects_left_out(c, side, &mut pieces, std::ptr::null_mut());
+                assert_eq!(status, ScStatus::Ok, "out_vertices may be NULL");
+            }
+            assert_eq!(
+                sc_correspondence_objects_left_out(c, 2, &mut pieces, &mut vertices),
+                ScStatus::InvalidArgument
+            );
+            assert_eq!(
+                sc_correspondence_objects_left_out(c, 0, std::ptr::null_mut(), &mut vertices),
+                ScStatus::NullArgument
+            );
+            assert_eq!(
+                sc_correspondence_objects_left_out(std::ptr::null(), 0, &mut pieces, &mut vertices),
+                ScStatus::NullArgument
+            );
+            sc_correspondence_free(c.cast_mut());
         }
     }
 

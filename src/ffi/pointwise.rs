@@ -6,7 +6,9 @@ use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
     Failure, FfiResult, ScStatus,
 };
-use super::correspondence::{write_working, ScCorrespondence, SC_SIDE_A, SC_SIDE_B};
+use super::correspondence::{
+    write_objects_left_out, write_working, ScCorrespondence, SC_SIDE_A, SC_SIDE_B,
+};
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
 use super::verdict::{self, VerdictText};
@@ -203,6 +205,24 @@ pub unsafe extern "C" fn sc_pointwise_regions(
             out_correspondence,
             ScCorrespondence::new(p.result.regions.clone()),
         )
+    })
+}
+
+/// The objects touching one side's figure that the pair job left out, as
+/// `sc_correspondence_objects_left_out`.
+///
+/// # Safety
+/// `pointwise` must be live; `out_pieces` writable, `out_vertices` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_objects_left_out(
+    pointwise: *const ScPointwise,
+    side: u32,
+    out_pieces: *mut usize,
+    out_vertices: *mut usize,
+) -> ScStatus {
+    boundary(|| {
+        let p = handle(pointwise, "pointwise")?;
+        write_objects_left_out(&p.result.regions, side, out_pieces, out_vertices)
     })
 }
 

@@ -25,7 +25,7 @@ use crate::shape::neighbors::PointTree;
 use crate::shape::proxy::{Proxy, ProxyKind};
 use crate::shape::smoothing;
 use crate::shape::ShapeKind;
-use crate::shape::{distance, Shape};
+use crate::shape::{distance, ObjectsLeftOut, Shape};
 use crate::spectral::eigen::{check_max_vertices, EigenParams};
 use crate::Result;
 
@@ -72,6 +72,9 @@ pub struct Working {
     /// Whether its positions were smoothed because the input is a noisy mesh
     /// ([`crate::shape::smoothing`]).
     pub smoothed: bool,
+    /// Objects touching the figure that were left out because the pair matched better
+    /// without them ([`Shape::without_touching_objects`]); zero when none.
+    pub objects_left_out: ObjectsLeftOut,
 }
 
 /// What the pipeline ran on for one input shape.
@@ -91,6 +94,13 @@ pub enum WorkingKind {
 }
 
 impl Working {
+    /// The warning that objects touching the figure were left out, when some were
+    /// ([`Working::objects_left_out`]).
+    pub fn left_out_warning(&self) -> Option<crate::shape::Warning> {
+        let ObjectsLeftOut { pieces, vertices } = self.objects_left_out;
+        (pieces > 0).then_some(crate::shape::Warning::TouchingObjectsLeftOut { pieces, vertices })
+    }
+
     /// The working shape of `shape` with its proxy, if any.
     pub fn of(shape: &Shape, proxy: Option<&Proxy>) -> Working {
         match proxy {
@@ -98,6 +108,7 @@ impl Working {
                 kind: WorkingKind::Input,
                 vertices: shape.active_vertices().len(),
                 smoothed: false,
+                objects_left_out: ObjectsLeftOut::default(),
             },
             Some(p) => Working {
                 kind: match p.kind {
@@ -107,6 +118,7 @@ impl Working {
                 },
                 vertices: p.shape.active_vertices().len(),
                 smoothed: p.smoothed,
+                objects_left_out: ObjectsLeftOut::default(),
             },
         }
     }

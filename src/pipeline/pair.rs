@@ -17,7 +17,7 @@ use crate::pipeline::Params;
 use crate::progress::Progress;
 use crate::shape::io::declared_size;
 use crate::shape::proxy::Proxy;
-use crate::shape::Shape;
+use crate::shape::{ObjectsLeftOut, Shape};
 use crate::spectral::eigen::{check_max_vertices, EigenParams, Eigenbasis, ShapeBasis};
 use crate::Result;
 
@@ -162,7 +162,10 @@ pub fn run_pair(
         let started = Instant::now();
         let mut answers = match shapes {
             PairShapes::Ready(a, b) => on_ready(a, b, job, progress)?,
-            PairShapes::Two(a, b) => prepare_and_run([a, b], job, progress)?,
+            PairShapes::Two(a, b) => {
+                let answers = prepare_and_run([a, b], job, progress)?;
+                without_touching_objects([a, b], answers, job, progress)?
+            }
             PairShapes::Itself(a) => prepare_itself_and_run(a, job, progress)?,
         };
         let total_s = started.elapsed().as_secs_f64();
@@ -221,6 +224,70 @@ fn prepare_and_run(
         answers.proxies_s += built;
     }
     Ok(answers)
+}
+
+/// A pair without the objects touching a figure is kept only when its chosen hypothesis
+/// costs at most this share of the answer's ([`without_touching_objects`]): a clear gain,
+/// not a tie. A round value, not tuned: the box's measured shares are 0.15-0.6
+/// (docs/scans.md, "Props").
+pub const TOUCHING_OBJECTS_GAIN: f64 = 0.8;
+
+/// The pair tried again without the closed objects joined to either figure
+/// ([`Shape::without_touching_objects`]: A's, B's, and both when both have some); the try
+/// whose chosen hypothesis costs least is kept when it costs at most
+/// [`TOUCHING_OBJECTS_GAIN`] times the answer's. A box touching a foot spoils every
+/// hypothesis (cost 1.7-6x, docs/scans.md, "Props"). Needs the verified hypotheses' costs
+/// ([`Params::verify_hypotheses`]); costs one more pair job per try, only for shapes
+/// with such objects.
+fn without_touching_objects(
+    [a, b]: [&Shape; 2],
+    answers: Answers,
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<Answers> {
+    let verdict = |answers: &Answers| {
+        let of_map = answers.map.as_ref().and_then(|m| m.verdict.as_ref());
+        of_map.or(answers.regions.verdict.as_ref()).cloned()
+    };
+    let chosen_cost = |answers: &Answers| verdict(answers).map(|v| v.chosen().energy.cost());
+    let Some(cost) = chosen_cost(&answers) else {
+        return Ok(answers);
+    };
+    let trimmed = [a, b].map(|s| s.without_touching_objects());
+    let keeps_landmarks = |side: usize, trimmed: &Shape| {
+        job.params
+            .landmarks
+            .iter()
+            .all(|l| trimmed.active_vertices().binary_search(&l[side]).is_ok())
+    };
+    let usable: Vec<Option<&(Shape, ObjectsLeftOut)>> = trimmed
+        .iter()
+        .enumerate()
+        .map(|(side, t)| t.as_ref().filter(|(s, _)| keeps_landmarks(side, s)))
+        .collect();
+    let tries: Vec<[bool; 2]> = [[true, false], [false, true], [true, true]]
+        .into_iter()
+        .filter(|&[on_a, on_b]| (!on_a || usable[0].is_some()) && (!on_b || usable[1].is_some()))
+        .collect();
+    let mut best: Option<(f64, Answers)> = None;
+    for [on_a, on_b] in tries {
+        let trim = |side: usize, on: bool| usable[side].filter(|_| on).map(|(s, l)| (s, *l));
+        let none = ObjectsLeftOut::default();
+        let (shape_a, left_a) = trim(0, on_a).unwrap_or((a, none));
+        let (shape_b, left_b) = trim(1, on_b).unwrap_or((b, none));
+        let mut tried = prepare_and_run([shape_a, shape_b], job, progress)?;
+        let Some(tried_cost) = chosen_cost(&tried) else {
+            continue;
+        };
+        if tried_cost <= TOUCHING_OBJECTS_GAIN * cost
+            && best.as_ref().is_none_or(|(c, _)| tried_cost < *c)
+        {
+            tried.regions.working[0].objects_left_out = left_a;
+            tried.regions.working[1].objects_left_out = left_b;
+            best = Some((tried_cost, tried));
+        }
+    }
+    Ok(best.map_or(answers, |(_, tried)| tried))
 }
 
 /// One shape matched to itself: one proxy and one eigenbasis, used on both sides (the

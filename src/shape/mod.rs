@@ -10,6 +10,7 @@
 pub mod cloud_orientation;
 pub mod io;
 pub mod neighbors;
+mod objects;
 pub mod proxy;
 pub mod repair;
 pub mod smoothing;
@@ -21,6 +22,7 @@ use std::collections::HashMap;
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::shape::io::RawShape;
 use crate::shape::neighbors::{symmetric_knn_graph, PointTree};
+pub use crate::shape::objects::{ObjectsLeftOut, TOUCHING_OBJECTS_AREA};
 use crate::shape::repair::PieceRole;
 pub use crate::shape::repair::Repairs;
 pub use crate::shape::warning::Warning;

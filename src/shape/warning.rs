@@ -85,6 +85,15 @@ pub enum Warning {
         /// Number of their vertices.
         vertices: usize,
     },
+    /// Pieces joined to the figure (a prop touching it) were left out because the pair
+    /// matched better without them ([`super::Shape::without_touching_objects`],
+    /// docs/scans.md, "Props"); their vertices take the answer of the nearest kept vertex.
+    TouchingObjectsLeftOut {
+        /// Number of pieces left out.
+        pieces: usize,
+        /// Number of their vertices.
+        vertices: usize,
+    },
     /// Vertices far from the rest of the shape were left out ([`Repairs::outliers`]), with
     /// their faces; they take the values of the nearest kept vertex.
     FarVerticesDropped {
@@ -109,6 +118,7 @@ impl Warning {
                 | Warning::PiecesJoined { .. }
                 | Warning::SmallPiecesDropped { .. }
                 | Warning::SeparateObjectsDropped { .. }
+                | Warning::TouchingObjectsLeftOut { .. }
                 | Warning::FarVerticesDropped { .. }
                 | Warning::OutlierPointsDropped { .. }
         )
@@ -164,6 +174,10 @@ impl std::fmt::Display for Warning {
             Warning::SeparateObjectsDropped { pieces, vertices } => write!(
                 f,
                 "{pieces} separate object(s) beside the figure ({vertices} vertices, not joined to its largest piece) left out; they take the answer of the nearest kept vertex"
+            ),
+            Warning::TouchingObjectsLeftOut { pieces, vertices } => write!(
+                f,
+                "{pieces} object(s) touching the figure ({vertices} vertices) left out: the pair matched better without them; they take the answer of the nearest kept vertex"
             ),
             Warning::FarVerticesDropped { count } => write!(
                 f,

@@ -400,6 +400,20 @@ static void check_working(const sc_correspondence *c, uint32_t side, size_t n) {
     CHECK_STATUS(sc_correspondence_working(NULL, side, &kind, &vertices, &smoothed),
                  SC_STATUS_NULL_ARGUMENT);
     CHECK(kind == 99 && vertices == 0, "nothing written on failure");
+    /* A generated figure in one piece has no object touching it to leave out. */
+    size_t pieces = 99, left_out = 99;
+    CHECK_STATUS(sc_correspondence_objects_left_out(c, side, &pieces, &left_out), SC_STATUS_OK);
+    CHECK(pieces == 0 && left_out == 0, "side %u: %zu pieces, %zu vertices left out", side,
+          pieces, left_out);
+    CHECK_STATUS(sc_correspondence_objects_left_out(c, side, &pieces, NULL), SC_STATUS_OK);
+    pieces = 99;
+    CHECK_STATUS(sc_correspondence_objects_left_out(c, 2, &pieces, &left_out),
+                 SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_objects_left_out(c, side, NULL, &left_out),
+                 SC_STATUS_NULL_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_objects_left_out(NULL, side, &pieces, &left_out),
+                 SC_STATUS_NULL_ARGUMENT);
+    CHECK(pieces == 99, "nothing written on failure");
 }
 
 /* A low-poly figure (600 vertices) runs on a refined copy, the plain one beside it on
@@ -1038,6 +1052,15 @@ static void test_pointwise_permuted_copy(void) {
         CHECK_STATUS(sc_pointwise_working(p, SC_SIDE_A, NULL, &vertices, NULL),
                      SC_STATUS_NULL_ARGUMENT);
         CHECK_STATUS(sc_pointwise_working(NULL, SC_SIDE_A, &kind, &vertices, NULL),
+                     SC_STATUS_NULL_ARGUMENT);
+        size_t pieces = 99, left_out = 99;
+        CHECK_STATUS(sc_pointwise_objects_left_out(p, SC_SIDE_B, &pieces, &left_out),
+                     SC_STATUS_OK);
+        CHECK(pieces == 0 && left_out == 0, "%zu pieces, %zu vertices left out", pieces,
+              left_out);
+        CHECK_STATUS(sc_pointwise_objects_left_out(p, 2, &pieces, NULL),
+                     SC_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(sc_pointwise_objects_left_out(NULL, SC_SIDE_B, &pieces, NULL),
                      SC_STATUS_NULL_ARGUMENT);
     }
 

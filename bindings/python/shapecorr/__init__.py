@@ -823,16 +823,22 @@ class Working(NamedTuple):
     vertices: int
     #: Whether its positions were smoothed because the input is a noisy mesh.
     smoothed: bool = False
+    #: Vertices of objects touching the figure (a prop beside a foot) that were left out
+    #: because the pair matched better without them; they take the answer of the nearest
+    #: kept vertex (docs/scans.md, "Props").
+    objects_left_out: int = 0
 
 
-def _working(function, result) -> tuple[Working, Working]:
-    """Both sides' :class:`Working` through ``sc_correspondence_working`` or
-    ``sc_pointwise_working``."""
+def _working(function, left_out, result) -> tuple[Working, Working]:
+    """Both sides' :class:`Working` through ``sc_correspondence_working`` and
+    ``sc_correspondence_objects_left_out`` (or their ``sc_pointwise_`` forms)."""
     sides = []
     for side in (_lib.SIDE_A, _lib.SIDE_B):
         kind, vertices, smoothed = ctypes.c_uint32(), ctypes.c_size_t(), ctypes.c_bool()
         _check(function(result, side, ctypes.byref(kind), ctypes.byref(vertices), ctypes.byref(smoothed)))
-        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value, smoothed.value))
+        pieces, objects = ctypes.c_size_t(), ctypes.c_size_t()
+        _check(left_out(result, side, ctypes.byref(pieces), ctypes.byref(objects)))
+        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value, smoothed.value, objects.value))
     return sides[0], sides[1]
 
 
@@ -1003,7 +1009,7 @@ class Correspondence(_Verdict, _Handle):
     def working(self) -> tuple[Working, Working]:
         """What the pipeline ran on for A and B: ``(kind, vertices)`` each, ``kind``
         ``"input"``, ``"proxy"`` (a dense shape) or ``"refined"`` (a low-poly mesh)."""
-        return _working(lib.sc_correspondence_working, self)
+        return _working(lib.sc_correspondence_working, lib.sc_correspondence_objects_left_out, self)
 
     @property
     def timings(self) -> dict[str, float]:
@@ -1146,7 +1152,7 @@ class PointwiseMap(_Verdict, _Handle):
     @property
     def working(self) -> tuple[Working, Working]:
         """What the map was computed on for A and B (as :attr:`Correspondence.working`)."""
-        return _working(lib.sc_pointwise_working, self)
+        return _working(lib.sc_pointwise_working, lib.sc_pointwise_objects_left_out, self)
 
     @property
     def timings(self) -> dict[str, float]:

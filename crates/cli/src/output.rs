@@ -8,6 +8,7 @@ use shapecorr::colors::{coordinate_colors, region_colors};
 use shapecorr::maps::hypotheses::{Decision, HypothesisScore, Verdict};
 use shapecorr::maps::placement::Placement;
 use shapecorr::options::{OptionGroup, OptionValue, Options, OPTIONS};
+use shapecorr::pipeline::multiresolution::Working;
 use shapecorr::pipeline::Correspondence;
 use shapecorr::progress::{Progress, Stage};
 use shapecorr::regions::graph::ShapeGraph;
@@ -309,6 +310,24 @@ pub fn budget_json(estimate: &shapecorr::pipeline::budget::Estimate) -> serde_js
     })
 }
 
+/// A shape's warnings and the pair's about it (objects touching the figure left out).
+fn warnings_of(shape: &Shape, working: &Working) -> Vec<String> {
+    let pair = working.left_out_warning();
+    (shape.warnings().iter().chain(&pair))
+        .map(|w| w.to_string())
+        .collect()
+}
+
+/// Prints on stderr what the pair job left out of either shape (objects touching a
+/// figure that the pair matched better without).
+pub fn print_left_out(working: &[Working; 2], [a, b]: [&std::path::Path; 2]) {
+    for ((side, path), w) in [('A', a), ('B', b)].into_iter().zip(working) {
+        if let Some(warning) = w.left_out_warning() {
+            errln!("shapecorr: repaired {side} ({}): {warning}", path.display());
+        }
+    }
+}
+
 /// What `result.json` records of a region correspondence, with [`set_verdict_json`]'s keys.
 pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> serde_json::Value {
     let mut value = json!({
@@ -327,8 +346,8 @@ pub fn correspondence_json(a: &Shape, b: &Shape, result: &Correspondence) -> ser
         "graph_a": graph_json(&result.graph_a),
         "graph_b": graph_json(&result.graph_b),
         "timings_s": result.timings,
-        "warnings_a": a.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
-        "warnings_b": b.warnings().iter().map(|w| w.to_string()).collect::<Vec<_>>(),
+        "warnings_a": warnings_of(a, &result.working[0]),
+        "warnings_b": warnings_of(b, &result.working[1]),
     });
     set_verdict_json(&mut value, result.verdict.as_ref());
     value

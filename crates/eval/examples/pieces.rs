@@ -5,7 +5,12 @@
 //! the map's mean geodesic error (truth by vertex copy) and the skin weights' mean
 //! absolute error per vertex and bone, the connected B beside them, and the time per pair.
 //!
-//!     cargo run --release -p shapecorr-eval --example pieces -- [N]
+//! With `--one-part`, B is instead the figure in pose 1 with a single bone's faces a piece
+//! of their own touching the rest (a modelled character's separate head, hand or foot), for
+//! every bone: a part of the figure must never be left out as an object touching it
+//! ([`Shape::without_touching_objects`]).
+//!
+//!     cargo run --release -p shapecorr-eval --example pieces -- [N] [--one-part]
 
 use std::time::Instant;
 
@@ -17,8 +22,14 @@ use shapecorr::transfer::TransferMode;
 use shapecorr::{NoProgress, Params, PointwiseCorrespondence, PointwiseParams, Shape};
 
 /// Map error, weights error and seconds of B (vertex `v` copies the figure's
-/// `original[v]`) matched to the rest figure `a`.
-fn measure(rig: &Rig, a: &Shape, b: &Shape, original: &[u32]) -> shapecorr::Result<[f64; 3]> {
+/// `original[v]`) matched to the rest figure `a`, with the vertices of B left out as objects
+/// touching the figure.
+fn measure(
+    rig: &Rig,
+    a: &Shape,
+    b: &Shape,
+    original: &[u32],
+) -> shapecorr::Result<([f64; 3], usize)> {
     let start = Instant::now();
     let result = PointwiseCorrespondence::compute(
         a,
@@ -66,7 +77,8 @@ fn measure(rig: &Rig, a: &Shape, b: &Shape, original: &[u32]) -> shapecorr::Resu
             sum += (carried[v * n + k] - rig.weights[x as usize * n + k]).abs();
         }
     }
-    Ok([map, sum / (original.len() * n) as f64, seconds])
+    let objects = result.regions.working[1].objects_left_out.vertices;
+    Ok(([map, sum / (original.len() * n) as f64, seconds], objects))
 }
 
 fn summary(name: &str, rows: &[[f64; 3]]) {
@@ -85,11 +97,99 @@ fn summary(name: &str, rows: &[[f64; 3]]) {
     );
 }
 
+/// The figure `posed` with the faces whose heaviest bone is `bone` made a piece of their
+/// own, shrunk by 0.5% about its centroid (touching the rest); with the vertex each copies.
+fn one_part_apart(
+    rig: &Rig,
+    posed: &[[f64; 3]],
+    bone: usize,
+) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
+    let n = rig.n_bones;
+    let heaviest = |t: &[u32; 3]| {
+        (0..n)
+            .max_by(|&x, &y| {
+                let w = |b: usize| {
+                    t.iter()
+                        .map(|&v| rig.weights[v as usize * n + b])
+                        .sum::<f64>()
+                };
+                w(x).total_cmp(&w(y)).then(y.cmp(&x))
+            })
+            .unwrap_or(0)
+    };
+    let mut vertices = posed.to_vec();
+    let mut original: Vec<u32> = (0..posed.len() as u32).collect();
+    let mut copy: std::collections::BTreeMap<u32, u32> = Default::default();
+    let mut triangles = Vec::new();
+    for t in &rig.rest.triangles {
+        if heaviest(t) != bone {
+            triangles.push(*t);
+            continue;
+        }
+        triangles.push(t.map(|v| {
+            *copy.entry(v).or_insert_with(|| {
+                vertices.push(posed[v as usize]);
+                original.push(v);
+                (vertices.len() - 1) as u32
+            })
+        }));
+    }
+    let first = posed.len();
+    let part = &mut vertices[first..];
+    let count = part.len().max(1) as f64;
+    let centre: [f64; 3] = std::array::from_fn(|c| part.iter().map(|p| p[c]).sum::<f64>() / count);
+    for p in part.iter_mut() {
+        *p = std::array::from_fn(|c| centre[c] + 0.995 * (p[c] - centre[c]));
+    }
+    (vertices, triangles, original)
+}
+
+/// `--one-part`: every bone's faces apart in turn, pose 1 of both figures.
+fn one_part(n: usize) -> shapecorr::Result<()> {
+    let mut rows = Vec::new();
+    let mut left_out = 0;
+    for kind in [FigureKind::Humanoid, FigureKind::Quadruped] {
+        let rig = synth::rig(kind, n)?;
+        let a = Shape::mesh(rig.rest.vertices.clone(), &rig.rest.triangles)?;
+        let posed = rig.deform(&rig.weights, Proportions::default(), 1)?;
+        let whole = Shape::mesh(posed.clone(), &rig.rest.triangles)?;
+        let identity: Vec<u32> = (0..posed.len() as u32).collect();
+        let baseline = measure(&rig, &a, &whole, &identity)?;
+        eprintln!("{kind:?} pose 1, one piece: map {:.4}", baseline.0[0]);
+        for bone in 0..rig.n_bones {
+            let (vertices, triangles, original) = one_part_apart(&rig, &posed, bone);
+            if vertices.len() == posed.len() {
+                continue;
+            }
+            let b = Shape::mesh(vertices, &triangles)?;
+            let (row, objects) = measure(&rig, &a, &b, &original)?;
+            eprintln!(
+                "{kind:?} bone {bone} apart ({} vertices): map {:.4} (one piece {:.4}), {} s, left out {objects}",
+                original.len() - posed.len(),
+                row[0],
+                baseline.0[0],
+                row[2]
+            );
+            left_out += usize::from(objects > 0);
+            rows.push(row);
+        }
+    }
+    println!("| B | pairs | mean | median | worst | failed (> 0.05) | weights MAE | seconds |");
+    println!("|---|---|---|---|---|---|---|---|");
+    summary("one bone's faces apart, touching", &rows);
+    println!(
+        "parts left out as touching objects: {left_out} of {}",
+        rows.len()
+    );
+    Ok(())
+}
+
 fn main() -> shapecorr::Result<()> {
-    let n: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(3000);
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let n: usize = args.iter().find_map(|s| s.parse().ok()).unwrap_or(3000);
+    if args.iter().any(|a| a == "--one-part") {
+        return one_part(n);
+    }
     let cuts = [
         ("one piece", 0, 0.0),
         ("per bone, touching", 1, 0.005),
@@ -120,7 +220,7 @@ fn main() -> shapecorr::Result<()> {
                         cut.n_pieces,
                     )
                 };
-                let row = measure(&rig, &a, &b, &original)?;
+                let (row, _) = measure(&rig, &a, &b, &original)?;
                 eprintln!("{kind:?} pose {pose}, {name} ({count} pieces): map {:.4}, weights {:.4}, {:.2} s", row[0], row[1], row[2]);
                 rows[c].push(row);
                 pieces[c].push(count);

@@ -177,6 +177,13 @@ fn one(
         _ => scores[0].error.mean,
     };
     let mut notes: Vec<String> = b_used.warnings().iter().map(|w| w.to_string()).collect();
+    let left_out = result.regions.working[1].objects_left_out;
+    if left_out.pieces > 0 {
+        notes.push(format!(
+            "{} touching object(s) of B left out ({} vertices)",
+            left_out.pieces, left_out.vertices
+        ));
+    }
     if flip_allowed {
         let oriented = |s: &Shape| match s.kind() {
             shapecorr::ShapeKind::PointCloud if s.oriented_triangles().is_some() => "oriented",

@@ -1,0 +1,129 @@
+//! Objects touching a figure (docs/scans.md, "Props"): the closed pieces joined to a mesh's
+//! figure, which only the pair can tell from parts of it.
+
+use std::collections::HashMap;
+
+use super::{representative_is_active, representatives, triangle_area, DisjointSets};
+use super::{Shape, ShapeKind, Warning, MIN_VERTICES};
+use crate::progress::Cancel;
+
+/// Share of a mesh's area that the closed pieces joined to its figure may hold at most for
+/// [`Shape::without_touching_objects`] to try the shape without them: a prop is smaller
+/// than the figure it stands beside (a box a tenth of a person's height holds 9% of the
+/// area). Chosen from that, not tuned on a benchmark.
+pub const TOUCHING_OBJECTS_AREA: f64 = 0.25;
+
+/// Closed pieces joined to a mesh's figure and left out ([`Shape::without_touching_objects`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ObjectsLeftOut {
+    /// Number of pieces.
+    pub pieces: usize,
+    /// Number of their active vertices.
+    pub vertices: usize,
+}
+
+impl Shape {
+    /// The same mesh without the closed pieces joined to its figure (a box touching a foot),
+    /// for the pair to tell a prop from a part (docs/scans.md, "Props"). `None` unless
+    /// bridges join pieces of the faces and some piece other than the largest is closed (no
+    /// boundary edge) and these hold at most [`TOUCHING_OBJECTS_AREA`] of the area. Open
+    /// pieces stay: a part modelled apart is cut where it joins the figure (a head open at
+    /// the neck, clothes, hair cards). Every vertex keeps its index; one left out takes the
+    /// answer of the nearest kept vertex.
+    pub fn without_touching_objects(&self) -> Option<(Shape, ObjectsLeftOut)> {
+        if self.kind != ShapeKind::Mesh || self.bridges.is_empty() {
+            return None;
+        }
+        let n = self.vertices.len();
+        let mut sets = DisjointSets::new(n);
+        for t in &self.triangles {
+            sets.union(t[0] as usize, t[1] as usize);
+            sets.union(t[1] as usize, t[2] as usize);
+        }
+        let mut area_of_root: HashMap<usize, f64> = HashMap::new();
+        let mut uses_of_edge: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in &self.triangles {
+            *area_of_root.entry(sets.find(t[0] as usize)).or_default() +=
+                triangle_area(&self.vertices, t);
+            for k in 0..3 {
+                let (x, y) = (t[k], t[(k + 1) % 3]);
+                *uses_of_edge.entry((x.min(y), x.max(y))).or_default() += 1;
+            }
+        }
+        let mut open: HashMap<usize, bool> = HashMap::new();
+        for (&(x, _), &uses) in &uses_of_edge {
+            if uses == 1 {
+                open.insert(sets.find(x as usize), true);
+            }
+        }
+        let total: f64 = area_of_root.values().sum();
+        let (&figure, _) = area_of_root
+            .iter()
+            .max_by(|x, y| x.1.total_cmp(y.1).then(y.0.cmp(x.0)))?;
+        let objects: Vec<usize> = area_of_root
+            .keys()
+            .copied()
+            .filter(|&root| root != figure && !open.contains_key(&root))
+            .collect();
+        let objects_area: f64 = objects.iter().map(|r| area_of_root[r]).sum();
+        if objects.is_empty() || objects_area > TOUCHING_OBJECTS_AREA * total {
+            return None;
+        }
+        let is_kept: Vec<bool> = (0..n).map(|v| !objects.contains(&sets.find(v))).collect();
+        let kept = |v: u32| is_kept[v as usize];
+        let triangles: Vec<[u32; 3]> = (self.triangles.iter())
+            .filter(|t| kept(t[0]))
+            .copied()
+            .collect();
+        let bridges: Vec<[u32; 3]> = (self.bridges.iter())
+            .filter(|t| t.iter().all(|&v| kept(v)))
+            .copied()
+            .collect();
+        let active: Vec<u32> = self.active.iter().copied().filter(|&v| kept(v)).collect();
+        if active.len() < MIN_VERTICES {
+            return None;
+        }
+        let left_out = ObjectsLeftOut {
+            pieces: objects.len(),
+            vertices: self.active.len() - active.len(),
+        };
+        let nearest = representatives(&self.vertices, &active, &Cancel::default()).ok()?;
+        let representative = self
+            .representative
+            .iter()
+            .enumerate()
+            .map(|(v, &rep)| {
+                if representative_is_active(&active, rep) {
+                    rep
+                } else {
+                    nearest[v]
+                }
+            })
+            .collect();
+        let mut warnings: Vec<Warning> = self
+            .warnings
+            .iter()
+            .filter(|w| !matches!(w, Warning::DisconnectedPieces { .. }))
+            .cloned()
+            .collect();
+        warnings.push(Warning::TouchingObjectsLeftOut {
+            pieces: left_out.pieces,
+            vertices: left_out.vertices,
+        });
+        let mut shape = Shape {
+            vertices: self.vertices.clone(),
+            triangles,
+            bridges,
+            kind: self.kind,
+            active,
+            representative,
+            n_pieces: 1,
+            warnings,
+            fingerprint: std::sync::OnceLock::new(),
+            intrinsic_delaunay: self.intrinsic_delaunay,
+        };
+        shape.n_pieces = shape.count_pieces(&Cancel::default()).ok()?;
+        Some((shape, left_out))
+    }
+}
