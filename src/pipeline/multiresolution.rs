@@ -202,23 +202,41 @@ impl Multiresolution {
             return Ok([smoothed_if_noisy(a, None), smoothed_if_noisy(b, None)]);
         }
         polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
-            let build = |shape: &Shape| -> Result<Option<Proxy>> {
-                cancel.check()?;
-                match self.kind_for(shape) {
-                    Some(ProxyKind::Simplified) => {
-                        Proxy::build_cancellable(shape, self.proxy_vertices, cancel).map(Some)
-                    }
-                    Some(ProxyKind::Refined) => {
-                        Proxy::refine_cancellable(shape, self.refine_below, cancel).map(Some)
-                    }
-                    _ => Ok(None),
-                }
-            };
-            let proxy_a = build(a).map_err(|e| e.in_shape('A'))?;
+            let proxy_a = self.build(a, cancel).map_err(|e| e.in_shape('A'))?;
             cancel.set_fraction(0.5);
-            let proxy_b = build(b).map_err(|e| e.in_shape('B'))?;
+            let proxy_b = self.build(b, cancel).map_err(|e| e.in_shape('B'))?;
             Ok([smoothed_if_noisy(a, proxy_a), smoothed_if_noisy(b, proxy_b)])
         })
+    }
+
+    /// The proxy of one shape when it needs one, cancellable like [`Self::proxies`].
+    pub(crate) fn proxy_polled(
+        &self,
+        shape: &Shape,
+        eigen: &EigenParams,
+        progress: &mut dyn Progress,
+    ) -> Result<Option<Proxy>> {
+        check_max_vertices(shape, eigen)?;
+        if !self.applies_to(shape) {
+            return Ok(smoothed_if_noisy(shape, None));
+        }
+        polled(progress, Stage::Proxy, (0.0, 0.5), |cancel| {
+            Ok(smoothed_if_noisy(shape, self.build(shape, cancel)?))
+        })
+    }
+
+    /// The proxy `shape` needs, if any, before smoothing.
+    fn build(&self, shape: &Shape, cancel: &Cancel) -> Result<Option<Proxy>> {
+        cancel.check()?;
+        match self.kind_for(shape) {
+            Some(ProxyKind::Simplified) => {
+                Proxy::build_cancellable(shape, self.proxy_vertices, cancel).map(Some)
+            }
+            Some(ProxyKind::Refined) => {
+                Proxy::refine_cancellable(shape, self.refine_below, cancel).map(Some)
+            }
+            _ => Ok(None),
+        }
     }
 }
 

@@ -18,8 +18,8 @@ use crate::progress::Progress;
 use crate::shape::io::declared_size;
 use crate::shape::proxy::Proxy;
 use crate::shape::{ObjectsLeftOut, Shape};
-use crate::spectral::eigen::{check_max_vertices, EigenParams, Eigenbasis, ShapeBasis};
-use crate::Result;
+use crate::spectral::eigen::{EigenParams, Eigenbasis, ShapeBasis};
+use crate::{Error, Result};
 
 /// What a pair job computes and with which parameters.
 #[derive(Debug, Clone, Copy)]
@@ -162,10 +162,7 @@ pub fn run_pair(
         let started = Instant::now();
         let mut answers = match shapes {
             PairShapes::Ready(a, b) => on_ready(a, b, job, progress)?,
-            PairShapes::Two(a, b) => {
-                let answers = prepare_and_run([a, b], job, progress)?;
-                without_touching_objects([a, b], answers, job, progress)?
-            }
+            PairShapes::Two(a, b) => prepare_and_run([a, b], job, progress)?,
             PairShapes::Itself(a) => prepare_itself_and_run(a, job, progress)?,
         };
         let total_s = started.elapsed().as_secs_f64();
@@ -193,12 +190,35 @@ struct Answers {
     proxies_s: f64,
 }
 
-/// Two shapes: proxies, both eigenbases (side by side when small), then the pair.
-fn prepare_and_run(
+/// A shape's proxy (when it needs one) and the eigenbasis of the shape the pipeline runs on.
+struct Prepared {
+    proxy: Option<Proxy>,
+    basis: Eigenbasis,
+}
+
+impl Prepared {
+    fn ready<'a>(&'a self, shape: &'a Shape) -> ReadyShape<'a> {
+        ReadyShape {
+            shape,
+            proxy: self.proxy.as_ref(),
+            basis: &self.basis,
+        }
+    }
+}
+
+/// What preparing shapes took: the eigenbases' seconds per side, the proxies' seconds.
+#[derive(Default, Clone, Copy)]
+struct PrepareTimes {
+    eigenbasis_s: [f64; 2],
+    proxies_s: f64,
+}
+
+/// Two shapes: proxies, then both eigenbases (side by side when small).
+fn prepare_two(
     [a, b]: [&Shape; 2],
     job: PairJob<'_>,
     progress: &mut dyn Progress,
-) -> Result<Answers> {
+) -> Result<([Prepared; 2], PrepareTimes)> {
     let eigen = job.eigen_params();
     let started = Instant::now();
     let [proxy_a, proxy_b] = job
@@ -208,22 +228,72 @@ fn prepare_and_run(
     let built = started.elapsed().as_secs_f64();
     let working_pair = (working(a, &proxy_a), working(b, &proxy_b));
     let ([basis_a, basis_b], eigenbasis_s) = Eigenbasis::pair(working_pair, &eigen, progress)?;
-    let ready_a = ReadyShape {
-        shape: a,
-        proxy: proxy_a.as_ref(),
-        basis: &basis_a,
+    let has_proxy = proxy_a.is_some() || proxy_b.is_some();
+    let prepared = [
+        Prepared {
+            proxy: proxy_a,
+            basis: basis_a,
+        },
+        Prepared {
+            proxy: proxy_b,
+            basis: basis_b,
+        },
+    ];
+    let proxies_s = if has_proxy { built } else { 0.0 };
+    Ok((
+        prepared,
+        PrepareTimes {
+            eigenbasis_s,
+            proxies_s,
+        },
+    ))
+}
+
+/// One shape: its proxy, then its eigenbasis.
+fn prepare_one(
+    shape: &Shape,
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<(Prepared, f64, f64)> {
+    let eigen = job.eigen_params();
+    let started = Instant::now();
+    let proxy = job
+        .params
+        .multiresolution
+        .proxy_polled(shape, &eigen, progress)?;
+    let built = if proxy.is_some() {
+        started.elapsed().as_secs_f64()
+    } else {
+        0.0
     };
-    let ready_b = ReadyShape {
-        shape: b,
-        proxy: proxy_b.as_ref(),
-        basis: &basis_b,
-    };
-    let mut answers = on_ready(ready_a, ready_b, job, progress)?;
-    answers.eigenbasis_s = eigenbasis_s;
-    if proxy_a.is_some() || proxy_b.is_some() {
-        answers.proxies_s += built;
-    }
+    let t = Instant::now();
+    let basis = Eigenbasis::compute(working(shape, &proxy), &eigen, progress)?;
+    Ok((Prepared { proxy, basis }, t.elapsed().as_secs_f64(), built))
+}
+
+/// The pair on prepared shapes, with what preparing them took.
+fn run_prepared(
+    [a, b]: [ReadyShape<'_>; 2],
+    times: PrepareTimes,
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<Answers> {
+    let mut answers = on_ready(a, b, job, progress)?;
+    answers.eigenbasis_s = times.eigenbasis_s;
+    answers.proxies_s += times.proxies_s;
     Ok(answers)
+}
+
+/// Two shapes: prepared, matched, then tried again without the objects touching them.
+fn prepare_and_run(
+    [a, b]: [&Shape; 2],
+    job: PairJob<'_>,
+    progress: &mut dyn Progress,
+) -> Result<Answers> {
+    let (prepared, times) = prepare_two([a, b], job, progress)?;
+    let ready = [prepared[0].ready(a), prepared[1].ready(b)];
+    let answers = run_prepared(ready, times, job, progress)?;
+    without_touching_objects([a, b], &prepared, answers, job, progress)
 }
 
 /// A pair without the objects touching a figure is kept only when its chosen hypothesis
@@ -232,24 +302,37 @@ fn prepare_and_run(
 /// (docs/scans.md, "Props").
 pub const TOUCHING_OBJECTS_GAIN: f64 = 0.8;
 
+/// The cost of the hypothesis the answer chose: the map's verdict when there is a map.
+fn chosen_cost(answers: &Answers) -> Option<f64> {
+    let of_map = answers.map.as_ref().and_then(|m| m.verdict.as_ref());
+    let verdict = of_map.or(answers.regions.verdict.as_ref())?;
+    Some(verdict.chosen().energy.cost())
+}
+
+/// Whether an error ends the whole job rather than one try of it: a cancel or a limit.
+fn ends_the_job(error: &Error) -> bool {
+    matches!(
+        error.innermost(),
+        Error::Cancelled | Error::ResourceLimit { .. }
+    )
+}
+
 /// The pair tried again without the closed objects joined to either figure
 /// ([`Shape::without_touching_objects`]: A's, B's, and both when both have some); the try
 /// whose chosen hypothesis costs least is kept when it costs at most
 /// [`TOUCHING_OBJECTS_GAIN`] times the answer's. A box touching a foot spoils every
 /// hypothesis (cost 1.7-6x, docs/scans.md, "Props"). Needs the verified hypotheses' costs
 /// ([`Params::verify_hypotheses`]); costs one more pair job per try, only for shapes
-/// with such objects.
+/// with such objects, and the side a try leaves as it is keeps its proxy and eigenbasis.
+/// A try that fails (a trimmed shape too small, a numerical failure) is skipped; a cancel
+/// or a limit ends the job.
 fn without_touching_objects(
     [a, b]: [&Shape; 2],
+    prepared: &[Prepared; 2],
     answers: Answers,
     job: PairJob<'_>,
     progress: &mut dyn Progress,
 ) -> Result<Answers> {
-    let verdict = |answers: &Answers| {
-        let of_map = answers.map.as_ref().and_then(|m| m.verdict.as_ref());
-        of_map.or(answers.regions.verdict.as_ref()).cloned()
-    };
-    let chosen_cost = |answers: &Answers| verdict(answers).map(|v| v.chosen().energy.cost());
     let Some(cost) = chosen_cost(&answers) else {
         return Ok(answers);
     };
@@ -272,10 +355,41 @@ fn without_touching_objects(
     let mut best: Option<(f64, Answers)> = None;
     for [on_a, on_b] in tries {
         let trim = |side: usize, on: bool| usable[side].filter(|_| on).map(|(s, l)| (s, *l));
-        let none = ObjectsLeftOut::default();
-        let (shape_a, left_a) = trim(0, on_a).unwrap_or((a, none));
-        let (shape_b, left_b) = trim(1, on_b).unwrap_or((b, none));
-        let mut tried = prepare_and_run([shape_a, shape_b], job, progress)?;
+        let tried = match (trim(0, on_a), trim(1, on_b)) {
+            (Some((ta, left_a)), Some((tb, left_b))) => prepare_two([ta, tb], job, progress)
+                .and_then(|(both, times)| {
+                    let ready = [both[0].ready(ta), both[1].ready(tb)];
+                    run_prepared(ready, times, job, progress).map(|t| (t, [left_a, left_b]))
+                }),
+            (Some((ta, left_a)), None) => {
+                prepare_one(ta, job, progress).and_then(|(one, eigen_s, proxy_s)| {
+                    let times = PrepareTimes {
+                        eigenbasis_s: [eigen_s, 0.0],
+                        proxies_s: proxy_s,
+                    };
+                    let ready = [one.ready(ta), prepared[1].ready(b)];
+                    let left = [left_a, ObjectsLeftOut::default()];
+                    run_prepared(ready, times, job, progress).map(|t| (t, left))
+                })
+            }
+            (None, Some((tb, left_b))) => {
+                prepare_one(tb, job, progress).and_then(|(one, eigen_s, proxy_s)| {
+                    let times = PrepareTimes {
+                        eigenbasis_s: [0.0, eigen_s],
+                        proxies_s: proxy_s,
+                    };
+                    let ready = [prepared[0].ready(a), one.ready(tb)];
+                    let left = [ObjectsLeftOut::default(), left_b];
+                    run_prepared(ready, times, job, progress).map(|t| (t, left))
+                })
+            }
+            (None, None) => continue,
+        };
+        let (mut tried, [left_a, left_b]) = match tried {
+            Ok(tried) => tried,
+            Err(e) if ends_the_job(&e) => return Err(e),
+            Err(_) => continue,
+        };
         let Some(tried_cost) = chosen_cost(&tried) else {
             continue;
         };
@@ -297,25 +411,13 @@ fn prepare_itself_and_run(
     job: PairJob<'_>,
     progress: &mut dyn Progress,
 ) -> Result<Answers> {
-    let eigen = job.eigen_params();
-    let started = Instant::now();
-    check_max_vertices(shape, &eigen)?;
-    let proxy = job.params.multiresolution.proxy(shape)?;
-    let built = started.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let basis = Eigenbasis::compute(working(shape, &proxy), &eigen, progress)?;
-    let eigenbasis_s = t.elapsed().as_secs_f64();
-    let ready = ReadyShape {
-        shape,
-        proxy: proxy.as_ref(),
-        basis: &basis,
+    let (prepared, eigen_s, proxies_s) = prepare_one(shape, job, progress)?;
+    let ready = prepared.ready(shape);
+    let times = PrepareTimes {
+        eigenbasis_s: [eigen_s, 0.0],
+        proxies_s,
     };
-    let mut answers = on_ready(ready, ready, job, progress)?;
-    answers.eigenbasis_s = [eigenbasis_s, 0.0];
-    if proxy.is_some() {
-        answers.proxies_s += built;
-    }
-    Ok(answers)
+    run_prepared([ready, ready], times, job, progress)
 }
 
 /// The pair on prepared shapes: the regions (verified by maps on the regions' bases,

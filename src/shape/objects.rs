@@ -1,7 +1,7 @@
 //! Objects touching a figure (docs/scans.md, "Props"): the closed pieces joined to a mesh's
 //! figure, which only the pair can tell from parts of it.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::{representative_is_active, representatives, triangle_area, DisjointSets};
 use super::{Shape, ShapeKind, Warning, MIN_VERTICES};
@@ -51,10 +51,10 @@ impl Shape {
                 *uses_of_edge.entry((x.min(y), x.max(y))).or_default() += 1;
             }
         }
-        let mut open: HashMap<usize, bool> = HashMap::new();
+        let mut open: HashSet<usize> = HashSet::new();
         for (&(x, _), &uses) in &uses_of_edge {
             if uses == 1 {
-                open.insert(sets.find(x as usize), true);
+                open.insert(sets.find(x as usize));
             }
         }
         let total: f64 = area_of_root.values().sum();
@@ -64,7 +64,7 @@ impl Shape {
         let objects: Vec<usize> = area_of_root
             .keys()
             .copied()
-            .filter(|&root| root != figure && !open.contains_key(&root))
+            .filter(|&root| root != figure && !open.contains(&root))
             .collect();
         let objects_area: f64 = objects.iter().map(|r| area_of_root[r]).sum();
         if objects.is_empty() || objects_area > TOUCHING_OBJECTS_AREA * total {
