@@ -561,11 +561,15 @@ pub const CLOSE_CALL: f64 = 1.5;
 pub const FULL_MARGIN_SCALE: f64 = 0.05;
 
 /// Consistency of a full-resolution map from B to A: the fraction of A's active vertices it
-/// reaches times the fraction of B's oriented faces whose image keeps its orientation.
-pub fn full_consistency(a: &Shape, (faces_a, faces_b): &OrientedFaces, p2p_ba: &[u32]) -> f64 {
-    let va = unit_size_vertices(a);
-    let normals_a = vertex_normals(&va, faces_a);
-    let kept = orientation_kept((&va, &normals_a), faces_b, p2p_ba).unwrap_or(0.0);
+/// reaches times, when both shapes have consistently oriented `faces`, the fraction of B's
+/// oriented faces whose image keeps its orientation. A point cloud has no faces: the
+/// fraction reached alone judges its close calls.
+pub fn full_consistency(a: &Shape, faces: Option<&OrientedFaces>, p2p_ba: &[u32]) -> f64 {
+    let kept = faces.map_or(1.0, |(faces_a, faces_b)| {
+        let va = unit_size_vertices(a);
+        let normals_a = vertex_normals(&va, faces_a);
+        orientation_kept((&va, &normals_a), faces_b, p2p_ba).unwrap_or(0.0)
+    });
     let reached = covered_vertices(p2p_ba, a.n_vertices()) as f64;
     reached / a.active_vertices().len().max(1) as f64 * kept
 }
@@ -1090,6 +1094,22 @@ mod tests {
         let kept_mirrored = sample_orientation((&a.vertices, &normals_a), &triangles, &mirrored);
         assert!(kept > 0.95, "identity keeps {kept}");
         assert!(kept_mirrored < 0.05, "mirror keeps {kept_mirrored}");
+    }
+
+    /// A point cloud's close call is judged by the share of A it reaches: a map that
+    /// folds half of the cloud onto the other half scores half the identity's.
+    #[test]
+    fn a_cloud_close_call_is_judged_by_the_share_reached() {
+        let meshes =
+            figure_poses(FigureKind::Humanoid, 2000, Proportions::default(), &[0]).unwrap();
+        let cloud = Shape::point_cloud(meshes[0].vertices.clone()).unwrap();
+        let n = cloud.n_vertices() as u32;
+        let identity: Vec<u32> = (0..n).collect();
+        let folded: Vec<u32> = (0..n).map(|v| v / 2).collect();
+        let whole = full_consistency(&cloud, None, &identity);
+        let half = full_consistency(&cloud, None, &folded);
+        assert!((whole - 1.0).abs() < 1e-12, "identity reaches {whole}");
+        assert!((half - 0.5).abs() < 0.01, "folded reaches {half}");
     }
 
     fn energy(distortion: f64) -> MapEnergy {

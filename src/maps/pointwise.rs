@@ -555,9 +555,7 @@ fn verified(
     // A close call is decided at full resolution, where the meshes' orientation is known
     // (unless the placement or the landmarks decided).
     let mut chosen_map = None;
-    if let (Some(rival), Some(faces), Decision::Cost) =
-        (verdict.close_call(), faces, verdict.decided_by)
-    {
+    if let (Some(rival), Decision::Cost) = (verdict.close_call(), verdict.decided_by) {
         cancel.check()?;
         let convert =
             |h: usize| fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel);
