@@ -549,7 +549,7 @@ pub const OPTIONS: &[OptionInfo] = &[
     .range(0.0, 1000.0),
     p2p(
         "p2p_orientation",
-        "pointwise map: verify the answer's mirror image as a hypothesis (orientable meshes)",
+        "pointwise map: verify the answer's mirror image as a hypothesis (orientable meshes, point clouds)",
         field!(Options, Bool, pointwise.orientation),
     ),
     p2p(

@@ -229,8 +229,8 @@ const OPTIONS_CAP: usize = 5040;
 /// figures measured were with two.)
 pub const MAX_ALTERNATIVES: usize = 2;
 
-/// The hypotheses to verify: the answer, its mirror image (`with_mirror`, orientable meshes:
-/// on point clouds a mirror image is as right as the answer), the symmetric groups, and up
+/// The hypotheses to verify: the answer, its mirror image (`with_mirror`: orientable meshes,
+/// and point clouds, where only the placement can tell the two apart), the symmetric groups, and up
 /// to [`MAX_ALTERNATIVES`] single-group alternatives ranked by the distortion of region
 /// distances. Duplicates are left out. (A further rearrangement of every group at once, a
 /// quadruped's front and back legs swapped, was tried at the verification's third stop

@@ -21,7 +21,7 @@ use crate::maps::landmarks::{landmark_error, Landmark};
 use crate::maps::placement::{self, Guidance, Placement};
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::regions::RegionMatches;
-use crate::shape::Shape;
+use crate::shape::{Shape, ShapeKind};
 use crate::spectral::descriptors::{hks, wks, HksParams, WksParams};
 use crate::spectral::eigen::{Eigenbasis, ShapeBasis};
 use crate::{Error, Result};
@@ -83,8 +83,8 @@ pub struct PointwiseParams {
     pub orientation_term: f64,
     /// Refinement of the first map.
     pub refinement: Refinement,
-    /// On orientable meshes, also verify the mirror image of the one-to-one region answer
-    /// (another choice in every symmetric group) as a hypothesis.
+    /// On orientable meshes and point clouds, also verify the mirror image of the one-to-one
+    /// region answer (another choice in every symmetric group) as a hypothesis.
     pub orientation: bool,
     /// Verify more region hypotheses than the answer (and its mirror image): the symmetric
     /// groups and the best single-group alternatives ([`hypotheses::candidates`]). Every
@@ -266,7 +266,10 @@ impl PointwiseMap {
         // Both shapes' faces consistently oriented (None for point clouds and
         // non-orientable surfaces): the orientation term and the mirror decision need them.
         // A one-to-one region answer may be the mirror image of the truth (paper, section
-        // 5.2): on orientable meshes, its mirror image is a second candidate.
+        // 5.2): on orientable meshes, its mirror image is a second candidate. So it is with
+        // a point cloud: its cost rarely tells the two apart, but where the shapes stand may
+        // (a half-turned answer's mirror image is the map with no turn; docs/scans.md,
+        // "Point clouds").
         let faces = if params.orientation || params.orientation_term > 0.0 {
             a.oriented_triangles().zip(b.oriented_triangles())
         } else {
@@ -275,7 +278,9 @@ impl PointwiseMap {
         let kinds_and_groups: Vec<(HypothesisKind, RegionGroups)> = match regions {
             // Regions verified already: their answer is the only hypothesis.
             Some(regions) if params.regions == RegionConstraints::OneToOne && !regions.verified => {
-                let with_mirror = params.orientation && faces.is_some();
+                let is_cloud = |s: &Shape| s.kind() == ShapeKind::PointCloud;
+                let with_mirror =
+                    params.orientation && (faces.is_some() || is_cloud(a) || is_cloud(b));
                 if params.hypotheses {
                     hypotheses::candidates(side_a, side_b, regions, with_mirror)
                 } else if with_mirror {

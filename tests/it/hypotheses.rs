@@ -5,6 +5,8 @@
 
 use shapecorr::evaluation::{pointwise_errors, ErrorSummary};
 use shapecorr::geodesic::HeatGeodesics;
+use shapecorr::maps::hypotheses::HypothesisKind;
+use shapecorr::maps::placement::{Guidance, Placement};
 use shapecorr::maps::pointwise::{PointwiseMap, PointwiseParams};
 use shapecorr::pipeline::{Correspondence, Params};
 use shapecorr::synth::{self, FigureKind, FigureMesh, Proportions};
@@ -98,6 +100,49 @@ fn mirrored_answer(regions: &Correspondence, mirror: &[u32]) -> Vec<(u32, u32)> 
         .collect();
     pairs.sort_unstable();
     pairs
+}
+
+/// A point cloud has no orientation, so its cost cannot tell an answer from its mirror
+/// image; where the shapes stand alike, the placement can. B's pose as a cloud, the answer
+/// forced to its mirror image: the mirror of that (the truth) is verified beside it and
+/// taken, with no left/right flip left in the map.
+#[test]
+fn a_clouds_mirror_image_answer_is_undone_where_the_shapes_stand_alike() {
+    let poses = meshes(FigureKind::Humanoid, 3000, Proportions::default(), &[0, 3]);
+    let mirror = synth::mirror_map(&poses[0]);
+    let a = shape(&poses[0]);
+    let b = Shape::point_cloud(poses[1].vertices.clone()).unwrap();
+    let (basis_a, basis_b) = (basis(&a), basis(&b));
+    let (regions, _) = regions_and_map((&a, &basis_a), (&b, &basis_b), &Params::default());
+    let mut forced = regions.clone();
+    forced.matches_one_to_one = mirrored_answer(&regions, &mirror);
+    forced.verdict = None;
+    assert_ne!(forced.matches_one_to_one, regions.matches_one_to_one);
+    let guidance = Guidance {
+        placement: Placement::Trust,
+        ..Default::default()
+    };
+    let map = PointwiseMap::guided(
+        ShapeBasis::new(&a, &basis_a),
+        ShapeBasis::new(&b, &basis_b),
+        Some(forced.matches_view()),
+        &PointwiseParams::default(),
+        &guidance,
+        &mut NoProgress,
+    )
+    .unwrap();
+    let verdict = map.verdict.as_ref().unwrap();
+    let kinds: Vec<&HypothesisKind> = verdict.scores.iter().map(|s| &s.kind).collect();
+    assert!(
+        kinds.contains(&&HypothesisKind::Mirror),
+        "verified: {kinds:?}"
+    );
+    let err = error(&a, basis_a.input_area, b.n_vertices(), &map.p2p_ba, &|v| v);
+    println!(
+        "humanoid 0 -> cloud 3, forced mirror image: {err:.4}, chose {:?}",
+        verdict.chosen().kind
+    );
+    assert!(err < 0.05, "error without the flip {err}");
 }
 
 #[test]

@@ -31,6 +31,7 @@ use shapecorr::spectral::eigen::{EigenParams, ShapeBasis};
 use shapecorr_eval::bench_pointwise::score_maps;
 use shapecorr_eval::bench_store::{BasisCache, ShapeStore};
 use shapecorr_eval::datasets::{default_data_root, pair_list, Pair};
+use shapecorr_eval::seeded::{fnv, random_rotation, turned};
 
 fn main() -> shapecorr::Result<()> {
     let mut args = std::env::args().skip(1);
@@ -266,13 +267,7 @@ fn turned_and_landmarks(
     let b = match rotate {
         Some(seed) => {
             let r = random_rotation(seed ^ fnv(&format!("{}>{}", pair.source, pair.target)));
-            b_given.with_vertices(
-                b_given
-                    .vertices()
-                    .iter()
-                    .map(|p| std::array::from_fn(|i| (0..3).map(|j| r[i][j] * p[j]).sum()))
-                    .collect(),
-            )?
+            b_given.with_vertices(turned(b_given.vertices(), &r))?
         }
         None => b_given,
     };
@@ -285,43 +280,6 @@ fn turned_and_landmarks(
         params.landmarks = landmarks_from_truth(b.vertices(), &truth, n_landmarks);
     }
     Ok((b, params))
-}
-
-/// A rotation drawn uniformly (a normalised random quaternion), from `seed`.
-fn random_rotation(seed: u64) -> [[f64; 3]; 3] {
-    use rand::{RngExt, SeedableRng};
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let gauss = |rng: &mut rand_chacha::ChaCha8Rng| {
-        let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    };
-    let q: [f64; 4] = std::array::from_fn(|_| gauss(&mut rng));
-    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let [w, x, y, z] = q.map(|c| c / n);
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - z * w),
-            2.0 * (x * z + y * w),
-        ],
-        [
-            2.0 * (x * y + z * w),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - x * w),
-        ],
-        [
-            2.0 * (x * z - y * w),
-            2.0 * (y * z + x * w),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
-}
-
-/// FNV-1a of a text: a per-pair seed that does not depend on the run.
-fn fnv(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
 }
 
 /// `n` landmark pairs from the ground truth `truth` ((A vertex, B vertex) pairs): B's

@@ -3,7 +3,8 @@
 //! 0.25%, 0.5% and 1% of B's bounding-box diagonal), with a box a tenth of B's height
 //! standing beside its lowest foot (touching it, and 3% of the height apart), and as a point
 //! cloud (B's vertices jittered by 0.2% of its height; A as a mesh and as a cloud; or the
-//! mesh's own vertices as a cloud, no jitter: "mesh points"), and the clean pair without the
+//! mesh's own vertices as a cloud, no jitter: "mesh points"; B's cloud turned at random,
+//! so that the shared frame of the benchmarks cannot help: "turned"), and the clean pair without the
 //! orientation terms ("clean unoriented": what a cloud lacks). Each B is mapped to A by the
 //! default pipeline (`p2p`) and scored on B's own vertices against the dataset's truth (mean
 //! geodesic error over sqrt(area) on A, a left/right flip allowed for clouds, a pair failed
@@ -26,6 +27,7 @@ use shapecorr::{NoProgress, PointwiseCorrespondence, PointwiseParams, Shape};
 use shapecorr_eval::bench_pointwise::score_maps;
 use shapecorr_eval::bench_store::{BasisCache, ShapeStore};
 use shapecorr_eval::datasets::{default_data_root, pair_list, Pair};
+use shapecorr_eval::seeded::{fnv, random_rotation, turned};
 
 /// A pair fails above this mean error (as the scans issue's table).
 const FAILED: f64 = 0.1;
@@ -35,7 +37,7 @@ const SAMPLES: usize = 1_000;
 /// FAUST_r shape's (the scans issue's box held 12% of the vertices).
 const BOX_GRID: usize = 12;
 /// The variants, in the order they run.
-const VARIANTS: [&str; 12] = [
+const VARIANTS: [&str; 13] = [
     "clean",
     "clean unoriented",
     "noise 0.25%",
@@ -46,6 +48,7 @@ const VARIANTS: [&str; 12] = [
     "mesh to cloud",
     "cloud to cloud",
     "cloud to mesh",
+    "mesh to cloud turned",
     "mesh points to cloud",
     "mesh points to mesh points",
 ];
@@ -150,6 +153,10 @@ fn one(
         "mesh to cloud" => (a.clone(), cloud(b, seed)?),
         "cloud to cloud" => (cloud(a, seed ^ 1)?, cloud(b, seed)?),
         "cloud to mesh" => (cloud(a, seed ^ 1)?, b.clone()),
+        "mesh to cloud turned" => {
+            let b_turned = b.with_vertices(turned(b.vertices(), &random_rotation(seed)))?;
+            (a.clone(), cloud(&b_turned, seed)?)
+        }
         "mesh points to cloud" => (Shape::point_cloud(a.vertices().to_vec())?, cloud(b, seed)?),
         "mesh points to mesh points" => (
             Shape::point_cloud(a.vertices().to_vec())?,
@@ -269,11 +276,4 @@ fn with_box(b: &Shape, gap: f64) -> shapecorr::Result<Shape> {
     };
     let with = synth::box_beside(&figure, 0.1, gap, BOX_GRID);
     Shape::mesh(with.vertices, &with.triangles)
-}
-
-/// FNV-1a of a text: a per-pair seed that does not depend on the run.
-fn fnv(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
 }

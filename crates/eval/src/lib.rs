@@ -10,7 +10,7 @@
 //! [`bench_store`] caches eigenbases and keeps resumable logs; [`bench_all`] runs every table
 //! and writes `docs/results.md`; [`plot`] draws the PNG figures; [`bench_tails`] runs every pair of every dataset for
 //! `docs/tails.md`; [`bench_scale`] measures time and memory against size (`docs/scale.md`);
-//! [`tails`] summarises every
+//! [`seeded`] gives per-pair seeds and random turns; [`tails`] summarises every
 //! score by its mean, median, worst pair and count of failed pairs.
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -25,4 +25,5 @@ pub mod bench_tails;
 pub mod datasets;
 pub mod plot;
 pub mod reeb;
+pub mod seeded;
 pub mod tails;
