@@ -557,8 +557,8 @@ fn verified(
     if !guidance.landmarks.is_empty() {
         verdict.apply_landmarks();
     }
-    // A close call is decided at full resolution, where the meshes' orientation is known
-    // (unless the placement or the landmarks decided).
+    // A close call is decided at full resolution, where a mesh's orientation is known and a
+    // cloud's coverage is (unless the placement or the landmarks decided).
     let mut chosen_map = None;
     if let (Some(rival), Decision::Cost) = (verdict.close_call(), verdict.decided_by) {
         cancel.check()?;
