@@ -355,37 +355,34 @@ fn without_touching_objects(
     let mut best: Option<(f64, Answers)> = None;
     for [on_a, on_b] in tries {
         let trim = |side: usize, on: bool| usable[side].filter(|_| on).map(|(s, l)| (s, *l));
-        let tried = match (trim(0, on_a), trim(1, on_b)) {
-            (Some((ta, left_a)), Some((tb, left_b))) => prepare_two([ta, tb], job, progress)
-                .and_then(|(both, times)| {
-                    let ready = [both[0].ready(ta), both[1].ready(tb)];
-                    run_prepared(ready, times, job, progress).map(|t| (t, [left_a, left_b]))
-                }),
-            (Some((ta, left_a)), None) => {
-                prepare_one(ta, job, progress).and_then(|(one, eigen_s, proxy_s)| {
-                    let times = PrepareTimes {
-                        eigenbasis_s: [eigen_s, 0.0],
-                        proxies_s: proxy_s,
+        let sides = [trim(0, on_a), trim(1, on_b)];
+        let shapes = [
+            sides[0].map_or(a, |(s, _)| s),
+            sides[1].map_or(b, |(s, _)| s),
+        ];
+        let left = sides.map(|side| side.map_or(ObjectsLeftOut::default(), |(_, l)| l));
+        let tried = match sides {
+            [None, None] => continue,
+            [Some(_), Some(_)] => prepare_two(shapes, job, progress).and_then(|(both, times)| {
+                let ready = [both[0].ready(shapes[0]), both[1].ready(shapes[1])];
+                run_prepared(ready, times, job, progress)
+            }),
+            // One side trimmed: the other keeps its proxy and eigenbasis.
+            _ => {
+                let side = usize::from(sides[0].is_none());
+                prepare_one(shapes[side], job, progress).and_then(|(one, eigen_s, proxies_s)| {
+                    let mut times = PrepareTimes {
+                        proxies_s,
+                        ..Default::default()
                     };
-                    let ready = [one.ready(ta), prepared[1].ready(b)];
-                    let left = [left_a, ObjectsLeftOut::default()];
-                    run_prepared(ready, times, job, progress).map(|t| (t, left))
+                    times.eigenbasis_s[side] = eigen_s;
+                    let mut ready = [prepared[0].ready(a), prepared[1].ready(b)];
+                    ready[side] = one.ready(shapes[side]);
+                    run_prepared(ready, times, job, progress)
                 })
             }
-            (None, Some((tb, left_b))) => {
-                prepare_one(tb, job, progress).and_then(|(one, eigen_s, proxy_s)| {
-                    let times = PrepareTimes {
-                        eigenbasis_s: [0.0, eigen_s],
-                        proxies_s: proxy_s,
-                    };
-                    let ready = [prepared[0].ready(a), one.ready(tb)];
-                    let left = [ObjectsLeftOut::default(), left_b];
-                    run_prepared(ready, times, job, progress).map(|t| (t, left))
-                })
-            }
-            (None, None) => continue,
         };
-        let (mut tried, [left_a, left_b]) = match tried {
+        let mut tried = match tried {
             Ok(tried) => tried,
             Err(e) if ends_the_job(&e) => return Err(e),
             Err(_) => continue,
@@ -396,8 +393,10 @@ fn without_touching_objects(
         if tried_cost <= TOUCHING_OBJECTS_GAIN * cost
             && best.as_ref().is_none_or(|(c, _)| tried_cost < *c)
         {
-            tried.regions.working[0].objects_left_out = left_a;
-            tried.regions.working[1].objects_left_out = left_b;
+            [
+                tried.regions.working[0].objects_left_out,
+                tried.regions.working[1].objects_left_out,
+            ] = left;
             best = Some((tried_cost, tried));
         }
     }
