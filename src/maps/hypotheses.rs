@@ -947,8 +947,8 @@ fn sample_orientation(
 
 /// Fraction of B's triangles whose image under `p2p_ba` keeps its orientation on A
 /// (the mapped triangle's normal agrees with A's vertex normals there), both shapes' faces
-/// taken as [`Shape::oriented_triangles`]; `None` when either shape is a point cloud or
-/// not orientable, or no triangle maps to a proper triangle.
+/// taken as [`Shape::oriented_triangles`]; `None` when either shape is not orientable (a
+/// cloud whose orientation is not trusted), or no triangle maps to a proper triangle.
 pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
     let va = unit_size_vertices(a);
     let normals_a = vertex_normals(&va, &a.oriented_triangles()?);

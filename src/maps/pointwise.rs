@@ -78,8 +78,8 @@ pub struct PointwiseParams {
     pub descriptor_commutativity: f64,
     /// Weight of the orientation-preserving term (Ren et al. 2018): the map commutes with
     /// every undiffused descriptor's orientation operator `g -> <n x grad f, grad g>`.
-    /// Used on orientable meshes (faces taken as [`Shape::oriented_triangles`]), not on
-    /// point clouds (0 = off).
+    /// Used on orientable meshes and on point clouds whose orientation is trusted (faces
+    /// taken as [`Shape::oriented_triangles`]; 0 = off).
     pub orientation_term: f64,
     /// Refinement of the first map.
     pub refinement: Refinement,
@@ -263,8 +263,9 @@ impl PointwiseMap {
         let started = Instant::now();
         let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
         let groups = constraint_groups(regions, params.regions)?;
-        // Both shapes' faces consistently oriented (None for point clouds and
-        // non-orientable surfaces): the orientation term and the mirror decision need them.
+        // Both shapes' faces consistently oriented (a cloud's local triangles turned by its
+        // normals; None for non-orientable surfaces and clouds whose orientation is not
+        // trusted): the orientation term and the mirror decision need them.
         // A one-to-one region answer may be the mirror image of the truth (paper, section
         // 5.2): on orientable meshes, its mirror image is a second candidate. So it is with
         // a point cloud: its cost rarely tells the two apart, but where the shapes stand may
@@ -565,6 +566,10 @@ fn verified(
         let convert =
             |h: usize| fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel);
         let (chosen_p2p, rival_p2p) = (convert(verdict.chosen)?, convert(rival)?);
+        // A cloud's local triangles do not settle a close call: a wrong map can keep more
+        // of them than the right one (docs/scans.md, "Point clouds").
+        let is_cloud = |s: &Shape| s.kind() == ShapeKind::PointCloud;
+        let faces = faces.filter(|_| !is_cloud(a) && !is_cloud(side_b.shape));
         let consistency = (
             hypotheses::full_consistency(a, faces, &chosen_p2p),
             hypotheses::full_consistency(a, faces, &rival_p2p),

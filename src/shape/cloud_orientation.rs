@@ -1,9 +1,8 @@
 //! Outward normals of a point cloud and its local triangles turned by them, so that a
-//! cloud's left and right could be known as a mesh's are. **Not used by the pipeline yet**
-//! (docs/scans.md, "Point clouds"): given to the orientation term, the mirror hypothesis and
-//! the orientation test, it took FAUST_r vertex clouds from 1.8-2.9x the mesh error to
-//! 1.2-1.5x, but broke a generated cloud sampled uniformly with noise (0.23 where the
-//! unoriented pipeline passes), and its agreement measure did not see why.
+//! cloud's left and right are known as a mesh's are ([`crate::Shape::oriented_triangles`]):
+//! the pointwise map's orientation term and orientation test use them. A close call is not
+//! settled by them: there a wrong map can keep more of them than the right one
+//! (docs/scans.md, "Point clouds").
 //!
 //! Normals by PCA over each point's nearest neighbours; their signs made consistent by
 //! propagation along a minimum spanning tree of the neighbour graph whose edges cost

@@ -91,6 +91,9 @@ pub struct Shape {
     warnings: Vec<Warning>,
     /// [`Shape::fingerprint`], computed on first use.
     fingerprint: std::sync::OnceLock<u64>,
+    /// A point cloud's oriented local triangles ([`Shape::oriented_triangles`]), computed on
+    /// first use.
+    cloud_faces: std::sync::OnceLock<Option<Vec<[u32; 3]>>>,
     /// Whether its Laplacian is built on the intrinsic Delaunay triangulation of its
     /// triangles ([`Shape::intrinsic_delaunay`]).
     intrinsic_delaunay: bool,
@@ -257,6 +260,7 @@ impl Shape {
             n_pieces: 0,
             warnings,
             fingerprint: std::sync::OnceLock::new(),
+            cloud_faces: std::sync::OnceLock::new(),
             intrinsic_delaunay: false,
         };
         match kind {
@@ -684,6 +688,7 @@ impl Shape {
             n_pieces: self.n_pieces,
             warnings: self.warnings.clone(),
             fingerprint: std::sync::OnceLock::new(),
+            cloud_faces: std::sync::OnceLock::new(),
             intrinsic_delaunay: self.intrinsic_delaunay,
         }
     }
@@ -700,11 +705,30 @@ impl Shape {
     /// most of its faces had). Orientation is carried across edges shared by exactly two
     /// faces, so a few flipped faces (an [`Warning::InconsistentOrientation`]) are turned
     /// back and pieces joined only at non-manifold edges are oriented separately. `None`
-    /// for a point cloud and for a non-orientable surface (a Moebius strip). The orientation
-    /// terms of the pointwise map need it; the Laplacian does not.
+    /// for a non-orientable surface (a Moebius strip). A point cloud gets its local
+    /// Delaunay triangles turned by its outward normals ([`cloud_orientation`]), or `None`
+    /// where that orientation is not trusted. The orientation terms of the pointwise map
+    /// need it; the Laplacian does not.
     pub fn oriented_triangles(&self) -> Option<Vec<[u32; 3]>> {
         if self.kind == ShapeKind::PointCloud {
-            return None;
+            return self
+                .cloud_faces
+                .get_or_init(|| {
+                    let points: Vec<[f64; 3]> = self
+                        .active
+                        .iter()
+                        .map(|&v| self.vertices[v as usize])
+                        .collect();
+                    let oriented = cloud_orientation::orient(&points);
+                    oriented.trusted().then(|| {
+                        oriented
+                            .triangles
+                            .iter()
+                            .map(|t| t.map(|i| self.active[i as usize]))
+                            .collect()
+                    })
+                })
+                .clone();
         }
         let faces = &self.triangles;
         // For every undirected edge, the faces using it and whether each runs it low -> high.

@@ -121,6 +121,7 @@ impl Shape {
             n_pieces: 1,
             warnings,
             fingerprint: std::sync::OnceLock::new(),
+            cloud_faces: std::sync::OnceLock::new(),
             intrinsic_delaunay: self.intrinsic_delaunay,
         };
         shape.n_pieces = shape.count_pieces(&Cancel::default()).ok()?;

@@ -102,8 +102,8 @@ fn mirrored_answer(regions: &Correspondence, mirror: &[u32]) -> Vec<(u32, u32)> 
     pairs
 }
 
-/// A point cloud has no orientation, so its cost cannot tell an answer from its mirror
-/// image; where the shapes stand alike, the placement can. B's pose as a cloud, the answer
+/// A point cloud's cost tells an answer from its mirror image only as far as its normals
+/// can be trusted; where the shapes stand alike, the placement can. B's pose as a cloud, the answer
 /// forced to its mirror image: the mirror of that (the truth) is verified beside it and
 /// taken, with no left/right flip left in the map.
 #[test]

@@ -443,12 +443,13 @@ fn orientation_score_tells_a_map_from_its_mirror_image() {
     let mirrored = shapecorr::maps::pointwise::orientation_score(&a, &b, &mirror).unwrap();
     println!("orientation kept: identity {kept:.3}, mirror {mirrored:.3}");
     assert!(kept > 0.95 && mirrored < 0.05, "{kept} {mirrored}");
-    // A point cloud has no orientation.
+    // A point cloud's orientation comes from its outward normals: it tells the two apart
+    // too, a little less sharply (a few normals near thin parts are wrong).
     let cloud = Shape::point_cloud(posed.vertices).unwrap();
-    assert_eq!(
-        shapecorr::maps::pointwise::orientation_score(&a, &cloud, &identity),
-        None
-    );
+    let score = |map: &[u32]| shapecorr::maps::pointwise::orientation_score(&a, &cloud, map);
+    let (kept, mirrored) = (score(&identity).unwrap(), score(&mirror).unwrap());
+    println!("cloud orientation kept: identity {kept:.3}, mirror {mirrored:.3}");
+    assert!(kept > 0.85 && mirrored < 0.15, "{kept} {mirrored}");
 }
 
 /// `||C D_a - sign D_b C||`, summed over the operator pairs, relative to `||C D_a||`.

@@ -326,11 +326,34 @@ fn oriented_triangles_turn_flipped_and_inward_faces_outward() {
         .iter()
         .zip(&f)
         .all(|(&t, u)| same_cycle(t, u.map(|i| i + n))));
-    // A point cloud has no faces to orient.
-    assert!(Shape::point_cloud(v.clone())
-        .unwrap()
+    // A point cloud's local triangles are turned outward by its normals: on the sphere,
+    // every one faces away from the centre.
+    let cloud = Shape::point_cloud(v.clone()).unwrap();
+    let local = cloud
         .oriented_triangles()
-        .is_none());
+        .expect("a sphere's cloud is oriented");
+    let facing_out = local
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            let (e, g) = (
+                [0, 1, 2].map(|k| b[k] - a[k]),
+                [0, 1, 2].map(|k| c[k] - a[k]),
+            );
+            let n = [
+                e[1] * g[2] - e[2] * g[1],
+                e[2] * g[0] - e[0] * g[2],
+                e[0] * g[1] - e[1] * g[0],
+            ];
+            n[0] * a[0] + n[1] * a[1] + n[2] * a[2] > 0.0
+        })
+        .count();
+    assert_eq!(
+        facing_out,
+        local.len(),
+        "{facing_out} of {} outward",
+        local.len()
+    );
 }
 
 #[test]
