@@ -263,9 +263,8 @@ impl PointwiseMap {
         let started = Instant::now();
         let k = params.fmap_size.min(basis_a.len()).min(basis_b.len());
         let groups = constraint_groups(regions, params.regions)?;
-        // Both shapes' faces consistently oriented (a cloud's local triangles turned by its
-        // normals; None for non-orientable surfaces and clouds whose orientation is not
-        // trusted): the orientation term and the mirror decision need them.
+        // Both shapes' oriented faces (a cloud's: its local triangles; None where not
+        // orientable or trusted): the orientation term and the mirror decision need them.
         // A one-to-one region answer may be the mirror image of the truth (paper, section
         // 5.2): on orientable meshes, its mirror image is a second candidate. So it is with
         // a point cloud: its cost rarely tells the two apart, but where the shapes stand may
