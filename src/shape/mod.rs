@@ -714,12 +714,7 @@ impl Shape {
             return self
                 .cloud_faces
                 .get_or_init(|| {
-                    let points: Vec<[f64; 3]> = self
-                        .active
-                        .iter()
-                        .map(|&v| self.vertices[v as usize])
-                        .collect();
-                    let oriented = cloud_orientation::orient(&points);
+                    let oriented = cloud_orientation::orient(&self.active_points());
                     oriented.trusted().then(|| {
                         oriented
                             .triangles

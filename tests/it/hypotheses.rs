@@ -103,9 +103,9 @@ fn mirrored_answer(regions: &Correspondence, mirror: &[u32]) -> Vec<(u32, u32)> 
 }
 
 /// A point cloud's cost tells an answer from its mirror image only as far as its normals
-/// can be trusted; where the shapes stand alike, the placement can. B's pose as a cloud, the answer
-/// forced to its mirror image: the mirror of that (the truth) is verified beside it and
-/// taken, with no left/right flip left in the map.
+/// can be trusted; where the shapes stand alike, the placement can. B's pose as a cloud,
+/// the answer forced to its mirror image: the mirror of that (the truth) is verified beside
+/// it and taken, with no left/right flip left in the map.
 #[test]
 fn a_clouds_mirror_image_answer_is_undone_where_the_shapes_stand_alike() {
     let poses = meshes(FigureKind::Humanoid, 3000, Proportions::default(), &[0, 3]);

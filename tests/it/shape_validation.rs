@@ -327,26 +327,19 @@ fn oriented_triangles_turn_flipped_and_inward_faces_outward() {
         .zip(&f)
         .all(|(&t, u)| same_cycle(t, u.map(|i| i + n))));
     // A point cloud's local triangles are turned outward by its normals: on the sphere,
-    // every one faces away from the centre.
+    // every one faces away from the centre (a positive triple product a . (b x c)).
     let cloud = Shape::point_cloud(v.clone()).unwrap();
     let local = cloud
         .oriented_triangles()
         .expect("a sphere's cloud is oriented");
+    let faces_out = |[a, b, c]: [[f64; 3]; 3]| {
+        a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0])
+            > 0.0
+    };
     let facing_out = local
         .iter()
-        .filter(|t| {
-            let [a, b, c] = t.map(|i| v[i as usize]);
-            let (e, g) = (
-                [0, 1, 2].map(|k| b[k] - a[k]),
-                [0, 1, 2].map(|k| c[k] - a[k]),
-            );
-            let n = [
-                e[1] * g[2] - e[2] * g[1],
-                e[2] * g[0] - e[0] * g[2],
-                e[0] * g[1] - e[1] * g[0],
-            ];
-            n[0] * a[0] + n[1] * a[1] + n[2] * a[2] > 0.0
-        })
+        .filter(|t| faces_out(t.map(|i| v[i as usize])))
         .count();
     assert_eq!(
         facing_out,
