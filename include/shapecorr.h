@@ -633,6 +633,19 @@ sc_status sc_correspondence_objects_left_out(const sc_correspondence *correspond
                                              size_t *out_pieces,
                                              size_t *out_vertices);
 
+// The objects touching one side's figure (`SC_SIDE_A` or `SC_SIDE_B`) that the pair job
+// could not try leaving out because the time limit (`time_limit_s`) passed first: the
+// answer matched them as part of the figure. `out_pieces` gets their number of pieces, 0
+// when none. Nothing is written on error.
+//
+// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
+//
+// # Safety
+// `correspondence` must be live; `out_pieces` writable.
+sc_status sc_correspondence_objects_not_tried(const sc_correspondence *correspondence,
+                                              uint32_t side,
+                                              size_t *out_pieces);
+
 // What settled the choice among the hypotheses (static; never free it): `"cost"` (the
 // cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
 // stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
@@ -865,6 +878,15 @@ sc_status sc_pointwise_objects_left_out(const sc_pointwise *pointwise,
                                         uint32_t side,
                                         size_t *out_pieces,
                                         size_t *out_vertices);
+
+// The objects touching one side's figure that the time limit kept the pair job from
+// trying without, as `sc_correspondence_objects_not_tried`.
+//
+// # Safety
+// `pointwise` must be live; `out_pieces` writable.
+sc_status sc_pointwise_objects_not_tried(const sc_pointwise *pointwise,
+                                         uint32_t side,
+                                         size_t *out_pieces);
 
 // What the pipeline ran on for one side, as `sc_correspondence_working` (the map was
 // computed on the same working shapes as its regions).

@@ -152,6 +152,9 @@ def working_lines(result, shapes=()):
         left_out = getattr(shape, "objects_left_out", 0)
         if left_out:
             lines.append(f"{side.upper()}: {left_out:,} vertices of an object touching the figure (a prop) were left out: the pair matched better without them; they take the answer of the nearest kept vertex")
+        not_tried = getattr(shape, "objects_not_tried", 0)
+        if not_tried:
+            lines.append(f"{side.upper()}: {not_tried} object(s) touching the figure were matched as part of it: the time limit passed before the pair could try without them (raise the time limit to try)")
         if kind == "input" and not smoothed:
             continue
         if kind == "input":

@@ -146,6 +146,9 @@ def working_notes(names, result):
         left_out = getattr(shape, "objects_left_out", 0)
         if left_out:
             notes.append(f"shapecorr: '{name}': {left_out:,} vertices of an object touching the figure (a prop) were left out: the pair matched better without them; they take the answer of the nearest kept vertex")
+        not_tried = getattr(shape, "objects_not_tried", 0)
+        if not_tried:
+            notes.append(f"shapecorr: '{name}': {not_tried} object(s) touching the figure were matched as part of it: the time limit passed before the pair could try without them (raise the time limit to try)")
         if kind == "input" and not smoothed:
             continue
         if kind == "input":

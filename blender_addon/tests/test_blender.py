@@ -285,6 +285,19 @@ def test_the_report_says_an_object_touching_the_figure_was_left_out(addon):
     ]
 
 
+def test_the_report_says_the_time_limit_kept_an_object_from_being_tried(addon):
+    from types import SimpleNamespace
+
+    Working = addon.shapecorr.Working
+    result = SimpleNamespace(
+        n_vertices_a=5000, n_vertices_b=5866,
+        working=(Working("input", 5000), Working("input", 5866, False, 0, 1)),
+    )
+    assert addon.operators.working_notes(["Body", "Body and box"], result) == [
+        "shapecorr: 'Body and box': 1 object(s) touching the figure were matched as part of it: the time limit passed before the pair could try without them (raise the time limit to try)",
+    ]
+
+
 def test_undo_removes_the_attributes(addon):
     operator = addon.operators.SHAPECORR_OT_match_regions
     assert {"REGISTER", "UNDO"} <= operator.bl_options

@@ -584,6 +584,44 @@ pub(crate) unsafe fn write_objects_left_out(
     Ok(())
 }
 
+/// The objects touching one side's figure (`SC_SIDE_A` or `SC_SIDE_B`) that the pair job
+/// could not try leaving out because the time limit (`time_limit_s`) passed first: the
+/// answer matched them as part of the figure. `out_pieces` gets their number of pieces, 0
+/// when none. Nothing is written on error.
+///
+/// Errors: `SC_STATUS_NULL_ARGUMENT`, `SC_STATUS_INVALID_ARGUMENT` (a bad side).
+///
+/// # Safety
+/// `correspondence` must be live; `out_pieces` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_correspondence_objects_not_tried(
+    correspondence: *const ScCorrespondence,
+    side: u32,
+    out_pieces: *mut usize,
+) -> ScStatus {
+    boundary(|| {
+        let c = handle(correspondence, "correspondence")?;
+        write_objects_not_tried(&c.result, side, out_pieces)
+    })
+}
+
+/// Writes side `side`'s objects not tried of `result` (`sc_correspondence_objects_not_tried`).
+///
+/// # Safety
+/// `out_pieces` must be NULL or writable.
+pub(crate) unsafe fn write_objects_not_tried(
+    result: &Correspondence,
+    side: u32,
+    out_pieces: *mut usize,
+) -> FfiResult {
+    let working = working_of(result, side)?;
+    let pieces = out_pieces
+        .as_mut()
+        .ok_or_else(|| Failure::null("out_pieces"))?;
+    *pieces = working.objects_not_tried;
+    Ok(())
+}
+
 /// What settled the choice among the hypotheses (static; never free it): `"cost"` (the
 /// cheapest), `"close call"` (settled at full resolution), `"placement"` (where the shapes
 /// stand, option `placement`), `"landmarks"` (`sc_params_set_landmarks`) or `"other answer"`
@@ -727,6 +765,7 @@ mod tests {
                         pieces: usize::from(kind == WorkingKind::Refined),
                         vertices: 40 * usize::from(kind == WorkingKind::Refined),
                     },
+                    objects_not_tried: 2 * usize::from(kind == WorkingKind::Input),
                 }
             }),
         });
@@ -858,6 +897,32 @@ mod tests {
             );
             assert_eq!(
                 sc_correspondence_objects_left_out(std::ptr::null(), 0, &mut pieces, &mut vertices),
+                ScStatus::NullArgument
+            );
+            sc_correspondence_free(c.cast_mut());
+        }
+    }
+
+    #[test]
+    fn objects_not_tried_gives_each_sides_count_and_checks_its_arguments() {
+        let c = with_verdict(None);
+        unsafe {
+            let mut pieces = 99;
+            for (side, want) in [(SC_SIDE_A, 2), (SC_SIDE_B, 0)] {
+                let status = sc_correspondence_objects_not_tried(c, side, &mut pieces);
+                assert_eq!(status, ScStatus::Ok);
+                assert_eq!(pieces, want);
+            }
+            assert_eq!(
+                sc_correspondence_objects_not_tried(c, 2, &mut pieces),
+                ScStatus::InvalidArgument
+            );
+            assert_eq!(
+                sc_correspondence_objects_not_tried(c, 0, std::ptr::null_mut()),
+                ScStatus::NullArgument
+            );
+            assert_eq!(
+                sc_correspondence_objects_not_tried(std::ptr::null(), 0, &mut pieces),
                 ScStatus::NullArgument
             );
             sc_correspondence_free(c.cast_mut());

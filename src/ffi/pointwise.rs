@@ -7,7 +7,8 @@ use super::boundary::{
     Failure, FfiResult, ScStatus,
 };
 use super::correspondence::{
-    write_objects_left_out, write_working, ScCorrespondence, SC_SIDE_A, SC_SIDE_B,
+    write_objects_left_out, write_objects_not_tried, write_working, ScCorrespondence, SC_SIDE_A,
+    SC_SIDE_B,
 };
 use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
@@ -223,6 +224,23 @@ pub unsafe extern "C" fn sc_pointwise_objects_left_out(
     boundary(|| {
         let p = handle(pointwise, "pointwise")?;
         write_objects_left_out(&p.result.regions, side, out_pieces, out_vertices)
+    })
+}
+
+/// The objects touching one side's figure that the time limit kept the pair job from
+/// trying without, as `sc_correspondence_objects_not_tried`.
+///
+/// # Safety
+/// `pointwise` must be live; `out_pieces` writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_objects_not_tried(
+    pointwise: *const ScPointwise,
+    side: u32,
+    out_pieces: *mut usize,
+) -> ScStatus {
+    boundary(|| {
+        let p = handle(pointwise, "pointwise")?;
+        write_objects_not_tried(&p.result.regions, side, out_pieces)
     })
 }
 

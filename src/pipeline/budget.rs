@@ -331,6 +331,17 @@ impl Budget {
         Ok(estimate)
     }
 
+    /// When the time limit passes for a job that starts `now` (or started at
+    /// [`Budget::started`], when set); `None` without a limit (0, or not a number of
+    /// seconds an [`Instant`] can hold).
+    pub fn deadline(&self, now: Instant) -> Option<Instant> {
+        if self.time_limit_s.is_nan() || self.time_limit_s <= 0.0 {
+            return None;
+        }
+        let limit = Duration::try_from_secs_f64(self.time_limit_s).ok()?;
+        self.started.unwrap_or(now).checked_add(limit)
+    }
+
     /// Runs `work` with `progress` wrapped so that it also stops the work once the time
     /// limit has passed; the work's cancel then becomes [`Error::ResourceLimit`] naming
     /// `time_limit_s`.
@@ -339,13 +350,12 @@ impl Budget {
         progress: &mut dyn Progress,
         work: impl FnOnce(&mut dyn Progress) -> Result<T>,
     ) -> Result<T> {
-        if self.time_limit_s <= 0.0 {
+        let Some(deadline) = self.deadline(Instant::now()) else {
             return work(progress);
-        }
-        let started = self.started.unwrap_or_else(Instant::now);
+        };
         let mut watched = Deadline {
             inner: progress,
-            deadline: started + Duration::from_secs_f64(self.time_limit_s),
+            deadline,
             passed_in: None,
         };
         let result = work(&mut watched);

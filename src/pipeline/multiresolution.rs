@@ -25,7 +25,7 @@ use crate::shape::neighbors::PointTree;
 use crate::shape::proxy::{Proxy, ProxyKind};
 use crate::shape::smoothing;
 use crate::shape::ShapeKind;
-use crate::shape::{distance, ObjectsLeftOut, Shape};
+use crate::shape::{distance, ObjectsLeftOut, Shape, Warning};
 use crate::spectral::eigen::{check_max_vertices, EigenParams};
 use crate::Result;
 
@@ -75,6 +75,10 @@ pub struct Working {
     /// Objects touching the figure that were left out because the pair matched better
     /// without them ([`Shape::without_touching_objects`]); zero when none.
     pub objects_left_out: ObjectsLeftOut,
+    /// Pieces touching the figure that the pair could not try leaving out because the
+    /// time limit passed first (`time_limit_s`); they were matched as part of it. Zero when
+    /// none.
+    pub objects_not_tried: usize,
 }
 
 /// What the pipeline ran on for one input shape.
@@ -94,11 +98,14 @@ pub enum WorkingKind {
 }
 
 impl Working {
-    /// The warning that objects touching the figure were left out, when some were
-    /// ([`Working::objects_left_out`]).
-    pub fn left_out_warning(&self) -> Option<crate::shape::Warning> {
+    /// The pair's warnings about this side: objects touching the figure left out
+    /// ([`Working::objects_left_out`]) or not tried ([`Working::objects_not_tried`]).
+    pub fn pair_warnings(&self) -> Vec<Warning> {
         let ObjectsLeftOut { pieces, vertices } = self.objects_left_out;
-        (pieces > 0).then_some(crate::shape::Warning::TouchingObjectsLeftOut { pieces, vertices })
+        let left_out = (pieces > 0).then_some(Warning::TouchingObjectsLeftOut { pieces, vertices });
+        let pieces = self.objects_not_tried;
+        let not_tried = (pieces > 0).then_some(Warning::TouchingObjectsNotTried { pieces });
+        left_out.into_iter().chain(not_tried).collect()
     }
 
     /// The working shape of `shape` with its proxy, if any.
@@ -109,6 +116,7 @@ impl Working {
                 vertices: shape.active_vertices().len(),
                 smoothed: false,
                 objects_left_out: ObjectsLeftOut::default(),
+                objects_not_tried: 0,
             },
             Some(p) => Working {
                 kind: match p.kind {
@@ -119,6 +127,7 @@ impl Working {
                 vertices: p.shape.active_vertices().len(),
                 smoothed: p.smoothed,
                 objects_left_out: ObjectsLeftOut::default(),
+                objects_not_tried: 0,
             },
         }
     }

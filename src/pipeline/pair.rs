@@ -14,7 +14,7 @@ use crate::pipeline::correspondence::Correspondence;
 use crate::pipeline::multiresolution::{lift_map, lift_regions, working, Working};
 use crate::pipeline::pointwise::{basis_params, regions_and_map};
 use crate::pipeline::Params;
-use crate::progress::Progress;
+use crate::progress::{Progress, Stage};
 use crate::shape::io::declared_size;
 use crate::shape::proxy::Proxy;
 use crate::shape::{ObjectsLeftOut, Shape};
@@ -158,11 +158,12 @@ pub fn run_pair(
         check_landmarks(&job.params.landmarks, a, b)?;
     }
     let estimate = job.params.budget.check(&job.budget_job([a, b]))?;
+    let deadline = job.params.budget.deadline(Instant::now());
     job.params.budget.run(progress, |progress| {
         let started = Instant::now();
         let mut answers = match shapes {
             PairShapes::Ready(a, b) => on_ready(a, b, job, progress)?,
-            PairShapes::Two(a, b) => prepare_and_run([a, b], job, progress)?,
+            PairShapes::Two(a, b) => prepare_and_run([a, b], job, deadline, progress)?,
             PairShapes::Itself(a) => prepare_itself_and_run(a, job, progress)?,
         };
         let total_s = started.elapsed().as_secs_f64();
@@ -284,16 +285,23 @@ fn run_prepared(
     Ok(answers)
 }
 
-/// Two shapes: prepared, matched, then tried again without the objects touching them.
+/// Two shapes: prepared, matched, then tried again without the objects touching them
+/// until `deadline` (the job's time limit).
 fn prepare_and_run(
     [a, b]: [&Shape; 2],
     job: PairJob<'_>,
+    deadline: Option<Instant>,
     progress: &mut dyn Progress,
 ) -> Result<Answers> {
     let (prepared, times) = prepare_two([a, b], job, progress)?;
     let ready = [prepared[0].ready(a), prepared[1].ready(b)];
     let answers = run_prepared(ready, times, job, progress)?;
-    without_touching_objects([a, b], &prepared, answers, job, progress)
+    let mut optional = OptionalWork {
+        inner: progress,
+        deadline,
+        out_of_time: false,
+    };
+    without_touching_objects([a, b], &prepared, answers, job, &mut optional)
 }
 
 /// A pair without the objects touching a figure is kept only when its chosen hypothesis
@@ -317,6 +325,38 @@ fn ends_the_job(error: &Error) -> bool {
     )
 }
 
+/// The progress of work the job may give up (a try without the objects touching a figure):
+/// once `deadline` has passed it stops that work, not the job, which keeps the answer it
+/// has. A cancel from `inner` (the user's) still ends the job.
+struct OptionalWork<'a> {
+    inner: &'a mut dyn Progress,
+    deadline: Option<Instant>,
+    /// Whether the deadline stopped the work.
+    out_of_time: bool,
+}
+
+impl OptionalWork<'_> {
+    fn past_deadline(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+}
+
+impl Progress for OptionalWork<'_> {
+    fn report(&mut self, stage: Stage, fraction: f32) -> bool {
+        if self.past_deadline() {
+            self.out_of_time = true;
+            return false;
+        }
+        let go_on = self.inner.report(stage, fraction);
+        // The job's own time limit ([`crate::pipeline::budget::Budget::run`]) may have
+        // passed since the check above: that stop is the deadline's too.
+        if !go_on && self.past_deadline() {
+            self.out_of_time = true;
+        }
+        go_on
+    }
+}
+
 /// The pair tried again without the closed objects joined to either figure
 /// ([`Shape::without_touching_objects`]: A's, B's, and both when both have some); the try
 /// whose chosen hypothesis costs least is kept when it costs at most
@@ -325,13 +365,15 @@ fn ends_the_job(error: &Error) -> bool {
 /// ([`Params::verify_hypotheses`]); costs one more pair job per try, only for shapes
 /// with such objects, and the side a try leaves as it is keeps its proxy and eigenbasis.
 /// A try that fails (a trimmed shape too small, a numerical failure) is skipped; a cancel
-/// or a limit ends the job.
+/// or a memory limit ends the job. The time limit ends the tries, not the job: the answer
+/// so far is kept and says which side's objects were not tried
+/// ([`crate::pipeline::multiresolution::Working::objects_not_tried`]).
 fn without_touching_objects(
     [a, b]: [&Shape; 2],
     prepared: &[Prepared; 2],
     answers: Answers,
     job: PairJob<'_>,
-    progress: &mut dyn Progress,
+    progress: &mut OptionalWork<'_>,
 ) -> Result<Answers> {
     let Some(cost) = chosen_cost(&answers) else {
         return Ok(answers);
@@ -353,6 +395,8 @@ fn without_touching_objects(
         .filter(|&[on_a, on_b]| (!on_a || usable[0].is_some()) && (!on_b || usable[1].is_some()))
         .collect();
     let mut best: Option<(f64, Answers)> = None;
+    // Which sides' objects a finished try has been without.
+    let mut tried_without = [false; 2];
     for [on_a, on_b] in tries {
         let trim = |side: usize, on: bool| usable[side].filter(|_| on).map(|(s, l)| (s, *l));
         let sides = [trim(0, on_a), trim(1, on_b)];
@@ -384,9 +428,12 @@ fn without_touching_objects(
         };
         let mut tried = match tried {
             Ok(tried) => tried,
+            Err(_) if progress.out_of_time => break,
             Err(e) if ends_the_job(&e) => return Err(e),
             Err(_) => continue,
         };
+        tried_without[0] |= on_a;
+        tried_without[1] |= on_b;
         let Some(tried_cost) = chosen_cost(&tried) else {
             continue;
         };
@@ -400,7 +447,15 @@ fn without_touching_objects(
             best = Some((tried_cost, tried));
         }
     }
-    Ok(best.map_or(answers, |(_, tried)| tried))
+    let mut kept = best.map_or(answers, |(_, tried)| tried);
+    if progress.out_of_time {
+        for (side, working) in kept.regions.working.iter_mut().enumerate() {
+            if let (Some((_, left)), false) = (usable[side], tried_without[side]) {
+                working.objects_not_tried = left.pieces;
+            }
+        }
+    }
+    Ok(kept)
 }
 
 /// One shape matched to itself: one proxy and one eigenbasis, used on both sides (the

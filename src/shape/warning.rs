@@ -94,6 +94,12 @@ pub enum Warning {
         /// Number of their vertices.
         vertices: usize,
     },
+    /// Pieces joined to the figure that the pair could not try leaving out because the
+    /// time limit (`time_limit_s`) passed first: they were matched as part of the figure.
+    TouchingObjectsNotTried {
+        /// Number of pieces.
+        pieces: usize,
+    },
     /// Vertices far from the rest of the shape were left out ([`Repairs::outliers`]), with
     /// their faces; they take the values of the nearest kept vertex.
     FarVerticesDropped {
@@ -178,6 +184,10 @@ impl std::fmt::Display for Warning {
             Warning::TouchingObjectsLeftOut { pieces, vertices } => write!(
                 f,
                 "{pieces} object(s) touching the figure ({vertices} vertices) left out: the pair matched better without them; they take the answer of the nearest kept vertex"
+            ),
+            Warning::TouchingObjectsNotTried { pieces } => write!(
+                f,
+                "{pieces} object(s) touching the figure kept: the time limit passed before the pair could try without them; raise time_limit_s to try"
             ),
             Warning::FarVerticesDropped { count } => write!(
                 f,

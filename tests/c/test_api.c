@@ -414,6 +414,13 @@ static void check_working(const sc_correspondence *c, uint32_t side, size_t n) {
     CHECK_STATUS(sc_correspondence_objects_left_out(NULL, side, &pieces, &left_out),
                  SC_STATUS_NULL_ARGUMENT);
     CHECK(pieces == 99, "nothing written on failure");
+    /* Nor any the time limit kept the job from trying without. */
+    CHECK_STATUS(sc_correspondence_objects_not_tried(c, side, &pieces), SC_STATUS_OK);
+    CHECK(pieces == 0, "side %u: %zu pieces not tried", side, pieces);
+    pieces = 99;
+    CHECK_STATUS(sc_correspondence_objects_not_tried(c, 2, &pieces), SC_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(sc_correspondence_objects_not_tried(c, side, NULL), SC_STATUS_NULL_ARGUMENT);
+    CHECK(pieces == 99, "nothing written on failure");
 }
 
 /* A low-poly figure (600 vertices) runs on a refined copy, the plain one beside it on
@@ -1061,6 +1068,10 @@ static void test_pointwise_permuted_copy(void) {
         CHECK_STATUS(sc_pointwise_objects_left_out(p, 2, &pieces, NULL),
                      SC_STATUS_INVALID_ARGUMENT);
         CHECK_STATUS(sc_pointwise_objects_left_out(NULL, SC_SIDE_B, &pieces, NULL),
+                     SC_STATUS_NULL_ARGUMENT);
+        CHECK_STATUS(sc_pointwise_objects_not_tried(p, SC_SIDE_B, &pieces), SC_STATUS_OK);
+        CHECK(pieces == 0, "%zu pieces not tried", pieces);
+        CHECK_STATUS(sc_pointwise_objects_not_tried(NULL, SC_SIDE_B, &pieces),
                      SC_STATUS_NULL_ARGUMENT);
     }
 

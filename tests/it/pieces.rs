@@ -192,8 +192,8 @@ fn a_box_touching_a_foot_does_not_pull_the_answer() {
             (1, n_box),
             "pose {pose}"
         );
-        assert!(result.regions.working[1].left_out_warning().is_some());
-        assert!(result.regions.working[0].left_out_warning().is_none());
+        assert_eq!(result.regions.working[1].pair_warnings().len(), 1);
+        assert!(result.regions.working[0].pair_warnings().is_empty());
     }
 }
 
@@ -226,4 +226,99 @@ fn only_small_closed_joined_pieces_are_objects_to_leave_out() {
         large.without_touching_objects().is_none(),
         "half the height: not a prop"
     );
+}
+
+/// Trying the pair without a box touching the figure is work the time limit may cut short:
+/// the job then keeps the answer it has and says the box was not tried, where it used to
+/// fail and lose that answer. A cancel from the user during the try still ends the job.
+#[test]
+fn the_time_limit_ends_the_try_without_a_touching_box_not_the_job() {
+    use shapecorr::pipeline::budget::Budget;
+    use shapecorr::{Error, Stage};
+    use std::time::{Duration, Instant};
+
+    let rig = synth::rig(FigureKind::Humanoid, 3000).unwrap();
+    let a = Shape::mesh(rig.rest.vertices.clone(), &rig.rest.triangles).unwrap();
+    let posed = rig.deform(&rig.weights, Proportions::default(), 1).unwrap();
+    let figure = synth::FigureMesh {
+        vertices: posed,
+        triangles: rig.rest.triangles.clone(),
+    };
+    let boxed = synth::box_beside(&figure, 0.1, 0.0, 8);
+    let b = Shape::mesh(boxed.vertices, &boxed.triangles).unwrap();
+    // A limit of a minute (above the estimate) whose clock started `ago`; the try starts
+    // with the trimmed shape's eigenbasis, after the answer's map: `at_try` is called
+    // then, and when that was is returned with the result.
+    let limit = 60.0;
+    let run = |ago: Duration, at_try: &dyn Fn(Instant) -> bool| {
+        let started = Instant::now().checked_sub(ago).unwrap();
+        let deadline = started + Duration::from_secs_f64(limit);
+        let params = Params {
+            budget: Budget {
+                time_limit_s: limit,
+                started: Some(started),
+                ..Default::default()
+            },
+            ..Params::default()
+        };
+        let (mut mapped, mut try_started) = (false, None);
+        let mut progress = |stage: Stage, _: f32| {
+            mapped |= stage == Stage::PointwiseMap;
+            let try_starts = matches!(stage, Stage::Laplacian | Stage::Eigenbasis);
+            if mapped && try_started.is_none() && try_starts {
+                try_started = Some(Instant::now());
+                return at_try(deadline);
+            }
+            true
+        };
+        let result = PointwiseCorrespondence::compute(
+            &a,
+            &b,
+            &params,
+            &PointwiseParams::default(),
+            &mut progress,
+        );
+        (result, try_started.map(|t| t.duration_since(started + ago)))
+    };
+    // Within the limit, the try runs and leaves the box out (as in the test above).
+    let (result, answer_took) = run(Duration::ZERO, &|_| true);
+    let working = &result.unwrap().regions.working;
+    assert_eq!(working[1].objects_not_tried, 0);
+    assert_eq!(working[1].objects_left_out.pieces, 1);
+    let answer_took = answer_took.expect("the pair tried without the box");
+    // The time limit passes as the try starts (the deadline set well after the answer
+    // should be ready, further on a loaded machine): the answer is kept.
+    let mut kept = false;
+    for room in [3, 6, 12] {
+        let ago = Duration::from_secs_f64(limit).saturating_sub(room * answer_took);
+        let (result, try_started) = run(ago, &|deadline| {
+            std::thread::sleep(deadline.saturating_duration_since(Instant::now()));
+            true
+        });
+        if try_started.is_none() {
+            // The limit passed before the answer: the job ends, as any job past its limit.
+            assert!(
+                matches!(result, Err(Error::ResourceLimit { .. })),
+                "{result:?}"
+            );
+            continue;
+        }
+        let result = result.expect("the answer before the try is kept");
+        let working = &result.regions.working;
+        assert_eq!(working[1].objects_not_tried, 1);
+        assert_eq!(working[1].objects_left_out.pieces, 0, "the box was matched");
+        assert_eq!(working[1].pair_warnings().len(), 1);
+        assert_eq!(working[0].objects_not_tried, 0);
+        assert_eq!(result.map.p2p_ba.len(), b.n_vertices());
+        kept = true;
+        break;
+    }
+    assert!(
+        kept,
+        "the answer took {answer_took:?}; the limit passed before it every time"
+    );
+    // The user's cancel during the try ends the job.
+    let (result, try_started) = run(Duration::ZERO, &|_| false);
+    assert!(try_started.is_some());
+    assert!(matches!(result, Err(Error::Cancelled)), "{result:?}");
 }

@@ -827,18 +827,25 @@ class Working(NamedTuple):
     #: because the pair matched better without them; they take the answer of the nearest
     #: kept vertex (docs/scans.md, "Props").
     objects_left_out: int = 0
+    #: Pieces touching the figure that the time limit (``time_limit_s``) kept the pair job
+    #: from trying without: they were matched as part of the figure.
+    objects_not_tried: int = 0
 
 
-def _working(function, left_out, result) -> tuple[Working, Working]:
-    """Both sides' :class:`Working` through ``sc_correspondence_working`` and
-    ``sc_correspondence_objects_left_out`` (or their ``sc_pointwise_`` forms)."""
+def _working(prefix, result) -> tuple[Working, Working]:
+    """Both sides' :class:`Working` through ``sc_correspondence_working``,
+    ``sc_correspondence_objects_left_out`` and ``sc_correspondence_objects_not_tried`` (or
+    their ``sc_pointwise_`` forms: ``prefix``)."""
     sides = []
     for side in (_lib.SIDE_A, _lib.SIDE_B):
         kind, vertices, smoothed = ctypes.c_uint32(), ctypes.c_size_t(), ctypes.c_bool()
-        _check(function(result, side, ctypes.byref(kind), ctypes.byref(vertices), ctypes.byref(smoothed)))
+        working = getattr(lib, f"{prefix}_working")
+        _check(working(result, side, ctypes.byref(kind), ctypes.byref(vertices), ctypes.byref(smoothed)))
         pieces, objects = ctypes.c_size_t(), ctypes.c_size_t()
-        _check(left_out(result, side, ctypes.byref(pieces), ctypes.byref(objects)))
-        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value, smoothed.value, objects.value))
+        _check(getattr(lib, f"{prefix}_objects_left_out")(result, side, ctypes.byref(pieces), ctypes.byref(objects)))
+        not_tried = ctypes.c_size_t()
+        _check(getattr(lib, f"{prefix}_objects_not_tried")(result, side, ctypes.byref(not_tried)))
+        sides.append(Working(_WORKING_KINDS[kind.value], vertices.value, smoothed.value, objects.value, not_tried.value))
     return sides[0], sides[1]
 
 
@@ -1009,7 +1016,7 @@ class Correspondence(_Verdict, _Handle):
     def working(self) -> tuple[Working, Working]:
         """What the pipeline ran on for A and B: ``(kind, vertices)`` each, ``kind``
         ``"input"``, ``"proxy"`` (a dense shape) or ``"refined"`` (a low-poly mesh)."""
-        return _working(lib.sc_correspondence_working, lib.sc_correspondence_objects_left_out, self)
+        return _working("sc_correspondence", self)
 
     @property
     def timings(self) -> dict[str, float]:
@@ -1152,7 +1159,7 @@ class PointwiseMap(_Verdict, _Handle):
     @property
     def working(self) -> tuple[Working, Working]:
         """What the map was computed on for A and B (as :attr:`Correspondence.working`)."""
-        return _working(lib.sc_pointwise_working, lib.sc_pointwise_objects_left_out, self)
+        return _working("sc_pointwise", self)
 
     @property
     def timings(self) -> dict[str, float]:

@@ -310,20 +310,26 @@ pub fn budget_json(estimate: &shapecorr::pipeline::budget::Estimate) -> serde_js
     })
 }
 
-/// A shape's warnings and the pair's about it (objects touching the figure left out).
+/// A shape's warnings and the pair's about it (objects touching the figure left out or
+/// not tried).
 fn warnings_of(shape: &Shape, working: &Working) -> Vec<String> {
-    let pair = working.left_out_warning();
+    let pair = working.pair_warnings();
     (shape.warnings().iter().chain(&pair))
         .map(|w| w.to_string())
         .collect()
 }
 
-/// Prints on stderr what the pair job left out of either shape (objects touching a
-/// figure that the pair matched better without).
+/// Prints on stderr the pair job's warnings about either shape: objects touching a figure
+/// that the pair matched better without, or that the time limit kept it from trying.
 pub fn print_left_out(working: &[Working; 2], [a, b]: [&std::path::Path; 2]) {
     for ((side, path), w) in [('A', a), ('B', b)].into_iter().zip(working) {
-        if let Some(warning) = w.left_out_warning() {
-            errln!("shapecorr: repaired {side} ({}): {warning}", path.display());
+        for warning in w.pair_warnings() {
+            let what = if warning.is_repair() {
+                "repaired"
+            } else {
+                "warning:"
+            };
+            errln!("shapecorr: {what} {side} ({}): {warning}", path.display());
         }
     }
 }
