@@ -395,7 +395,7 @@ fn without_touching_objects(
         .filter(|&[on_a, on_b]| (!on_a || usable[0].is_some()) && (!on_b || usable[1].is_some()))
         .collect();
     let mut best: Option<(f64, Answers)> = None;
-    // Which sides' objects a finished try has been without.
+    // Which sides' objects a try that ran to its end (an answer or a failure) was without.
     let mut tried_without = [false; 2];
     for [on_a, on_b] in tries {
         let trim = |side: usize, on: bool| usable[side].filter(|_| on).map(|(s, l)| (s, *l));
@@ -426,14 +426,16 @@ fn without_touching_objects(
                 })
             }
         };
+        if tried.is_err() && progress.out_of_time {
+            break;
+        }
+        tried_without[0] |= on_a;
+        tried_without[1] |= on_b;
         let mut tried = match tried {
             Ok(tried) => tried,
-            Err(_) if progress.out_of_time => break,
             Err(e) if ends_the_job(&e) => return Err(e),
             Err(_) => continue,
         };
-        tried_without[0] |= on_a;
-        tried_without[1] |= on_b;
         let Some(tried_cost) = chosen_cost(&tried) else {
             continue;
         };
