@@ -87,6 +87,11 @@ pub struct Job {
     pub conversion_size: usize,
     /// Threads of the dense products.
     pub threads: usize,
+    /// Sides the pair may try again without the objects touching their figure
+    /// ([`crate::Shape::may_have_touching_objects`]): a try holds the first answer's
+    /// shapes and bases beside its own work. The tries add no time: the time limit ends
+    /// them, not the job.
+    pub objects_tried: [bool; 2],
 }
 
 const MIB: f64 = 1024.0 * 1024.0;
@@ -208,7 +213,15 @@ pub fn estimate(job: &Job) -> Estimate {
     // Input shapes replaced by proxies are held at full size, and a proxy's construction
     // comes before the working shapes' own memory.
     let (inputs, proxy_stage, proxy_seconds) = proxied_inputs(job);
-    let bytes = BASE_BYTES + inputs + (kept + eigensolve.max(conversion)).max(proxy_stage);
+    // A try without objects holds what the first answer kept and the trimmed copies of the
+    // inputs it runs on (measured: peaks 1.17-1.20 of the estimate without this, on 20K-
+    // and 50K-vertex humanoids with a box at a foot; docs/scans.md, "Props").
+    let trimmed: u64 = (0..2)
+        .filter(|&i| job.objects_tried[i])
+        .map(|i| job.inputs[i] as u64 * INPUT_BYTES_PER_VERTEX)
+        .sum();
+    let tries = if trimmed > 0 { kept + trimmed } else { 0 };
+    let bytes = BASE_BYTES + inputs + tries + (kept + eigensolve.max(conversion)).max(proxy_stage);
     let doublings = |n: u64| (n.max(2) as f64).log2();
     let eigen_seconds = [n_a, n_b]
         .map(|n| EIGEN_SECONDS * (n * k) as f64 * doublings(n))
@@ -400,5 +413,6 @@ pub fn regions_job(vertices: [usize; 2], eigen: &EigenParams, verify: bool) -> J
         conversions: if verify { 3 } else { 0 },
         conversion_size: eigen.n_eigenpairs,
         threads: effective_threads(eigen.threads),
+        objects_tried: [false; 2],
     }
 }

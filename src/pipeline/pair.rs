@@ -157,7 +157,15 @@ pub fn run_pair(
     if !matches!(shapes, PairShapes::Itself(_)) {
         check_landmarks(&job.params.landmarks, a, b)?;
     }
-    let estimate = job.params.budget.check(&job.budget_job([a, b]))?;
+    let objects_tried = match shapes {
+        PairShapes::Two(a, b) => [a, b].map(Shape::may_have_touching_objects),
+        PairShapes::Itself(_) | PairShapes::Ready(..) => [false; 2],
+    };
+    let budget_job = Job {
+        objects_tried,
+        ..job.budget_job([a, b])
+    };
+    let estimate = job.params.budget.check(&budget_job)?;
     let deadline = job.params.budget.deadline(Instant::now());
     job.params.budget.run(progress, |progress| {
         let started = Instant::now();

@@ -24,6 +24,13 @@ pub struct ObjectsLeftOut {
 }
 
 impl Shape {
+    /// Whether [`Shape::without_touching_objects`] may find objects: a mesh whose pieces
+    /// were joined by bridges. Cheap, and true for more shapes than have such objects (a
+    /// figure modelled in open pieces): what a budget needs before any work.
+    pub fn may_have_touching_objects(&self) -> bool {
+        self.kind == ShapeKind::Mesh && !self.bridges.is_empty()
+    }
+
     /// The same mesh without the closed pieces joined to its figure (a box touching a foot),
     /// for the pair to tell a prop from a part (docs/scans.md, "Props"). `None` unless
     /// bridges join pieces of the faces and some piece other than the largest is closed (no
@@ -32,7 +39,7 @@ impl Shape {
     /// the neck, clothes, hair cards). Every vertex keeps its index; one left out takes the
     /// answer of the nearest kept vertex.
     pub fn without_touching_objects(&self) -> Option<(Shape, ObjectsLeftOut)> {
-        if self.kind != ShapeKind::Mesh || self.bridges.is_empty() {
+        if !self.may_have_touching_objects() {
             return None;
         }
         let n = self.vertices.len();

@@ -234,6 +234,7 @@ fn only_small_closed_joined_pieces_are_objects_to_leave_out() {
 #[test]
 fn the_time_limit_ends_the_try_without_a_touching_box_not_the_job() {
     use shapecorr::pipeline::budget::Budget;
+    use shapecorr::pipeline::PairJob;
     use shapecorr::{Error, Stage};
     use std::time::{Duration, Instant};
 
@@ -282,9 +283,22 @@ fn the_time_limit_ends_the_try_without_a_touching_box_not_the_job() {
     };
     // Within the limit, the try runs and leaves the box out (as in the test above).
     let (result, answer_took) = run(Duration::ZERO, &|_| true);
-    let working = &result.unwrap().regions.working;
+    let result = result.unwrap();
+    let working = &result.regions.working;
     assert_eq!(working[1].objects_not_tried, 0);
     assert_eq!(working[1].objects_left_out.pieces, 1);
+    // The budget counted the try's memory (it holds the first answer), not its time.
+    let pointwise = PointwiseParams::default();
+    let (params, map) = (Params::default(), Some(&pointwise));
+    let without_try = PairJob {
+        params: &params,
+        map,
+    }
+    .budget_job([&a, &b]);
+    assert_eq!(without_try.objects_tried, [false; 2]);
+    let without_try = shapecorr::pipeline::budget::estimate(&without_try);
+    assert!(result.estimate.bytes > without_try.bytes);
+    assert_eq!(result.estimate.seconds, without_try.seconds);
     let answer_took = answer_took.expect("the pair tried without the box");
     // The time limit passes as the try starts (the deadline set well after the answer
     // should be ready, further on a loaded machine): the answer is kept.
