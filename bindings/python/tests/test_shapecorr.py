@@ -377,9 +377,9 @@ def test_working_says_input_proxy_or_refined(humanoids):
     working_a, working_b = result.working
     assert isinstance(working_a, shapecorr.Working)
     assert working_a.kind == "refined" and working_a.vertices > low.n_vertices, working_a
-    assert working_b == ("input", b.n_vertices, False, 0)
+    assert working_b == ("input", b.n_vertices, False, 0, 0)
     assert shapecorr.match(a, b, verify_hypotheses=False).working == (
-        ("input", a.n_vertices, False, 0), ("input", b.n_vertices, False, 0),
+        ("input", a.n_vertices, False, 0, 0), ("input", b.n_vertices, False, 0, 0),
     )
     dense = shapecorr.match(a, b, verify_hypotheses=False, proxy_above=2000, proxy_vertices=1000)
     assert [w.kind for w in dense.working] == ["proxy", "proxy"]
@@ -395,7 +395,7 @@ def test_a_noisy_mesh_is_matched_on_a_smoothed_copy(humanoids):
     rng = np.random.default_rng(3)
     noisy = shapecorr.Shape.mesh(b.vertices + rng.normal(0, 0.01 * diagonal / 3**0.5, (b.n_vertices, 3)), b.triangles)
     result = shapecorr.match(a, noisy, verify_hypotheses=False)
-    assert result.working == (("input", a.n_vertices, False, 0), ("input", b.n_vertices, True, 0))
+    assert result.working == (("input", a.n_vertices, False, 0, 0), ("input", b.n_vertices, True, 0, 0))
     clean = shapecorr.match(a, b, verify_hypotheses=False)
     assert symmetric_accuracy(result, result.matches) >= 0.8 * symmetric_accuracy(clean, clean.matches)
 
@@ -517,7 +517,7 @@ def test_permuted_copy_is_mapped_back(humanoids):
     assert stages[-1][0] == "pointwise_map" and all(0.0 <= f <= 1.0 for _, f in stages)
     assert {s for s, _ in stages} >= {"eigenbasis", "segmentation", "matching", "pointwise_map"}
     assert (result.n_vertices_a, result.n_vertices_b) == (a.n_vertices, b.n_vertices)
-    assert result.working == (("input", a.n_vertices, False, 0), ("input", b.n_vertices, False, 0))
+    assert result.working == (("input", a.n_vertices, False, 0, 0), ("input", b.n_vertices, False, 0, 0))
     assert result.working == result.regions.working
     mapped = result.map_b_to_a
     assert mapped.dtype == np.uint32 and mapped.shape == (b.n_vertices,)
