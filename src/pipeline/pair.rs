@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use crate::maps::landmarks::check_landmarks;
 use crate::maps::pointwise::{pin_landmarks, PointwiseMap, PointwiseParams, Refinement};
-use crate::pipeline::budget::{regions_job, Estimate, Job};
+use crate::pipeline::budget::{regions_job, Budget, Estimate, Job};
 use crate::pipeline::correspondence::Correspondence;
 use crate::pipeline::multiresolution::{lift_map, lift_regions, working, Working};
 use crate::pipeline::pointwise::{basis_params, regions_and_map};
@@ -166,8 +166,13 @@ pub fn run_pair(
         ..job.budget_job([a, b])
     };
     let estimate = job.params.budget.check(&budget_job)?;
-    let deadline = job.params.budget.deadline(Instant::now());
-    job.params.budget.run(progress, |progress| {
+    // The clock started once, so that the tries stop at the job's own deadline.
+    let budget = Budget {
+        started: Some(job.params.budget.started.unwrap_or_else(Instant::now)),
+        ..job.params.budget.clone()
+    };
+    let deadline = budget.deadline(Instant::now());
+    budget.run(progress, |progress| {
         let started = Instant::now();
         let mut answers = match shapes {
             PairShapes::Ready(a, b) => on_ready(a, b, job, progress)?,
@@ -356,8 +361,8 @@ impl Progress for OptionalWork<'_> {
             return false;
         }
         let go_on = self.inner.report(stage, fraction);
-        // The job's own time limit ([`crate::pipeline::budget::Budget::run`]) may have
-        // passed since the check above: that stop is the deadline's too.
+        // The job's own time limit ([`Budget::run`], the same deadline) may have passed
+        // since the check above: that stop is the deadline's too.
         if !go_on && self.past_deadline() {
             self.out_of_time = true;
         }

@@ -295,7 +295,6 @@ fn the_time_limit_ends_the_try_without_a_touching_box_not_the_job() {
         map,
     }
     .budget_job([&a, &b]);
-    assert_eq!(without_try.objects_tried, [false; 2]);
     let without_try = shapecorr::pipeline::budget::estimate(&without_try);
     assert!(result.estimate.bytes > without_try.bytes);
     assert_eq!(result.estimate.seconds, without_try.seconds);

@@ -321,7 +321,7 @@ fn warnings_of(shape: &Shape, working: &Working) -> Vec<String> {
 
 /// Prints on stderr the pair job's warnings about either shape: objects touching a figure
 /// that the pair matched better without, or that the time limit kept it from trying.
-pub fn print_left_out(working: &[Working; 2], [a, b]: [&std::path::Path; 2]) {
+pub fn print_pair_warnings(working: &[Working; 2], [a, b]: [&std::path::Path; 2]) {
     for ((side, path), w) in [('A', a), ('B', b)].into_iter().zip(working) {
         for warning in w.pair_warnings() {
             let what = if warning.is_repair() {

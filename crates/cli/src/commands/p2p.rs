@@ -13,9 +13,9 @@ use crate::input::ShapePairArgs;
 use crate::options::PointwiseOptions;
 use crate::output::{
     budget_json, choice_summary, clear_other, confidence_summary, correspondence_json, create_dir,
-    create_out_dir, end_progress_line, options_json, other_names, print_doubtful, print_left_out,
-    set_guidance_json, set_verdict_json, write_colored, write_json, write_map, write_map_colors,
-    TerminalProgress, OTHER_DIR,
+    create_out_dir, end_progress_line, options_json, other_names, print_doubtful,
+    print_pair_warnings, set_guidance_json, set_verdict_json, write_colored, write_json, write_map,
+    write_map_colors, TerminalProgress, OTHER_DIR,
 };
 
 /// The files `p2p` writes into its folder, and into its `other/` folder for the runner-up.
@@ -109,7 +109,7 @@ impl P2pArgs {
             "look at {} (the runner-up's map, b_mapped.ply)",
             other_dir.display()
         );
-        print_left_out(&result.regions.working, [&self.pair.a, &self.pair.b]);
+        print_pair_warnings(&result.regions.working, [&self.pair.a, &self.pair.b]);
         print_doubtful(result.verdict(), params, &look);
         Ok(())
     }

@@ -13,7 +13,7 @@ use crate::options::RegionOptions;
 use crate::output::{
     budget_json, choice_summary, clear_other, confidence_summary, correspondence_json, create_dir,
     create_out_dir, end_progress_line, graph_json, options_json, other_names, print_doubtful,
-    print_left_out, set_guidance_json, write_colored, write_json, TerminalProgress, OTHER_DIR,
+    print_pair_warnings, set_guidance_json, write_colored, write_json, TerminalProgress, OTHER_DIR,
 };
 
 /// The files `match` writes into its folder.
@@ -98,7 +98,7 @@ impl MatchArgs {
             "look at {} (the runner-up's one-to-one regions)",
             other_dir.display()
         );
-        print_left_out(&result.working, [&self.pair.a, &self.pair.b]);
+        print_pair_warnings(&result.working, [&self.pair.a, &self.pair.b]);
         print_doubtful(verdict, &options.params, &look);
         Ok(())
     }
