@@ -34,6 +34,8 @@
 //!
 //! [`sample_points`] turns a figure into a (noisy) point cloud that remembers the vertex of
 //! every point.
+//! [`cut_below`], [`cut_extremity`], [`with_holes`] and [`seen_from`] give parts of a figure
+//! (a plane cut, holes, one camera's view) that remember the whole's vertex of each of theirs.
 //!
 //! ```
 //! use shapecorr::synth::{figure, FigureKind, FigureSpec};
@@ -45,6 +47,7 @@
 
 mod field;
 mod geom;
+mod partial;
 mod pieces;
 mod polygonize;
 mod props;
@@ -58,6 +61,7 @@ use std::fmt;
 use crate::{Error, Result};
 use geom::V3;
 
+pub use partial::{cut_below, cut_by_plane, cut_extremity, seen_from, with_holes, Part};
 pub use pieces::{cut_into_pieces, PiecesMesh};
 pub use props::box_beside;
 pub use sampling::{sample_points, with_noise, SampledCloud};

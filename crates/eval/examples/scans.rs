@@ -4,7 +4,8 @@
 //! standing beside its lowest foot (touching it, and 3% of the height apart), and as a point
 //! cloud (B's vertices jittered by 0.2% of its height; A as a mesh and as a cloud; or the
 //! mesh's own vertices as a cloud, no jitter: "mesh points"; B's cloud turned at random,
-//! so that the shared frame of the benchmarks cannot help: "turned"), and the clean pair without the
+//! so that the shared frame of the benchmarks cannot help: "turned"; B with the box, as a
+//! cloud: "cloud box"), and the clean pair without the
 //! orientation terms ("clean unoriented": what a cloud lacks). Each B is mapped to A by the
 //! default pipeline (`p2p`) and scored on B's own vertices against the dataset's truth (mean
 //! geodesic error over sqrt(area) on A, a left/right flip allowed for clouds, a pair failed
@@ -37,7 +38,7 @@ const SAMPLES: usize = 1_000;
 /// FAUST_r shape's (the scans issue's box held 12% of the vertices).
 const BOX_GRID: usize = 12;
 /// The variants, in the order they run.
-const VARIANTS: [&str; 13] = [
+const VARIANTS: [&str; 15] = [
     "clean",
     "clean unoriented",
     "noise 0.25%",
@@ -51,6 +52,8 @@ const VARIANTS: [&str; 13] = [
     "mesh to cloud turned",
     "mesh points to cloud",
     "mesh points to mesh points",
+    "cloud box touching",
+    "cloud box apart",
 ];
 
 fn main() -> shapecorr::Result<()> {
@@ -162,6 +165,8 @@ fn one(
             Shape::point_cloud(a.vertices().to_vec())?,
             Shape::point_cloud(b.vertices().to_vec())?,
         ),
+        "cloud box touching" => (a.clone(), cloud(&with_box(b, 0.0)?, seed)?),
+        "cloud box apart" => (a.clone(), cloud(&with_box(b, 0.03)?, seed)?),
         other => panic!("unknown variant {other}"),
     };
     let mut pointwise = PointwiseParams::default();
