@@ -7,6 +7,9 @@ use rand_chacha::ChaCha8Rng;
 
 use super::FigureMesh;
 
+/// The largest depth buffer side of [`seen_from`] (128 MiB of depths).
+pub const MAX_RESOLUTION: usize = 4_096;
+
 /// A part of a figure's mesh.
 #[derive(Debug, Clone)]
 pub struct Part {
@@ -92,9 +95,12 @@ pub fn with_holes(whole: &FigureMesh, count: usize, radius: f64, seed: u64) -> P
     let (lo, hi) = extent_along(&whole.vertices, &[0.0, 1.0, 0.0]);
     let reach2 = (radius * (hi - lo)).powi(2);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let centres: Vec<[f64; 3]> = (0..count)
-        .map(|_| whole.vertices[rng.random_range(0..whole.vertices.len())])
-        .collect();
+    let centres: Vec<[f64; 3]> = match whole.vertices.len() {
+        0 => Vec::new(),
+        n => (0..count)
+            .map(|_| whole.vertices[rng.random_range(0..n)])
+            .collect(),
+    };
     let near = |p: &[f64; 3]| {
         centres
             .iter()
@@ -105,8 +111,9 @@ pub fn with_holes(whole: &FigureMesh, count: usize, radius: f64, seed: u64) -> P
 }
 
 /// The faces of `whole` that a camera far along `view` sees (an orthographic depth buffer
-/// of `resolution` x `resolution` cells over the figure): faces turned towards the camera
-/// whose corners are not behind a nearer surface, as a single-view scan holds them.
+/// of `resolution` x `resolution` cells over the figure, at most [`MAX_RESOLUTION`]): faces
+/// turned towards the camera whose corners are not behind a nearer surface, as a
+/// single-view scan holds them.
 pub fn seen_from(whole: &FigureMesh, view: [f64; 3], resolution: usize) -> Part {
     let length = dot(&view, &view).sqrt().max(f64::MIN_POSITIVE);
     let w = view.map(|x| x / length);
@@ -126,7 +133,7 @@ pub fn seen_from(whole: &FigureMesh, view: [f64; 3], resolution: usize) -> Part 
     let (lo_u, hi_u) = extent_along(&whole.vertices, &u);
     let (lo_v, hi_v) = extent_along(&whole.vertices, &v);
     let (lo_w, hi_w) = extent_along(&whole.vertices, &w);
-    let cells = resolution.max(2);
+    let cells = resolution.clamp(2, MAX_RESOLUTION);
     let size = (hi_u - lo_u).max(hi_v - lo_v).max(f64::MIN_POSITIVE) / (cells - 1) as f64;
     let cell_of = |x: f64, lo: f64| (((x - lo) / size).round().max(0.0) as usize).min(cells - 1);
     let mut depth = vec![f64::NEG_INFINITY; cells * cells];
