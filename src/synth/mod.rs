@@ -173,6 +173,18 @@ pub struct FigureMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+impl FigureMesh {
+    /// The surface area: the sum of the triangles' areas.
+    pub fn area(&self) -> f64 {
+        (self.triangles.iter())
+            .map(|t| {
+                let [a, b, c] = t.map(|k| self.vertices[k as usize]);
+                geom::triangle_area(a, b, c)
+            })
+            .sum()
+    }
+}
+
 /// Smallest and largest accepted `target_vertices`.
 const TARGET_RANGE: (usize, usize) = (500, 200_000);
 /// Relaxation rounds after polygonisation.

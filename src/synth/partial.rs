@@ -5,6 +5,7 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::geom::{cross, dot, normalize, sub};
 use super::FigureMesh;
 
 /// The largest depth buffer side of [`seen_from`] (128 MiB of depths).
@@ -50,23 +51,19 @@ fn keep_triangles(whole: &FigureMesh, keep: impl Fn(&[u32; 3]) -> bool) -> Part 
     }
 }
 
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// The faces of `whole` whose corners all lie on the side of the plane `normal . p >=
 /// offset` (the rest cut away).
 pub fn cut_by_plane(whole: &FigureMesh, normal: [f64; 3], offset: f64) -> Part {
     keep_triangles(whole, |t| {
         t.iter()
-            .all(|&v| dot(&normal, &whole.vertices[v as usize]) >= offset)
+            .all(|&v| dot(normal, whole.vertices[v as usize]) >= offset)
     })
 }
 
 /// `whole` with its lowest `share` of its height cut away (y up), as a scanner's field of
 /// view cuts the feet off.
 pub fn cut_below(whole: &FigureMesh, share: f64) -> Part {
-    let (lo, hi) = extent_along(&whole.vertices, &[0.0, 1.0, 0.0]);
+    let (lo, hi) = extent_along(&whole.vertices, [0.0, 1.0, 0.0]);
     cut_by_plane(whole, [0.0, 1.0, 0.0], lo + share * (hi - lo))
 }
 
@@ -81,18 +78,18 @@ pub fn cut_extremity(whole: &FigureMesh, share: f64) -> Part {
         .vertices
         .iter()
         .map(|p| std::array::from_fn::<f64, 3, _>(|i| p[i] - centre[i]))
-        .max_by(|a, b| dot(a, a).total_cmp(&dot(b, b)))
+        .max_by(|&a, &b| dot(a, a).total_cmp(&dot(b, b)))
         .unwrap_or([0.0, 1.0, 0.0]);
-    let reach = dot(&far, &far).sqrt().max(f64::MIN_POSITIVE);
+    let reach = dot(far, far).sqrt().max(f64::MIN_POSITIVE);
     let away = far.map(|x| -x / reach);
     // Keep `away . p >= away . centre - (1 - share) * reach`.
-    cut_by_plane(whole, away, dot(&away, &centre) - (1.0 - share) * reach)
+    cut_by_plane(whole, away, dot(away, centre) - (1.0 - share) * reach)
 }
 
 /// `whole` with `count` holes: the faces with a corner within `radius` x the height of
 /// one of `count` vertices drawn at random (seeded) are removed.
 pub fn with_holes(whole: &FigureMesh, count: usize, radius: f64, seed: u64) -> Part {
-    let (lo, hi) = extent_along(&whole.vertices, &[0.0, 1.0, 0.0]);
+    let (lo, hi) = extent_along(&whole.vertices, [0.0, 1.0, 0.0]);
     let reach2 = (radius * (hi - lo)).powi(2);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let centres: Vec<[f64; 3]> = match whole.vertices.len() {
@@ -115,24 +112,23 @@ pub fn with_holes(whole: &FigureMesh, count: usize, radius: f64, seed: u64) -> P
 /// turned towards the camera whose corners are not behind a nearer surface, as a
 /// single-view scan holds them.
 pub fn seen_from(whole: &FigureMesh, view: [f64; 3], resolution: usize) -> Part {
-    let length = dot(&view, &view).sqrt().max(f64::MIN_POSITIVE);
-    let w = view.map(|x| x / length);
+    let w = normalize(view);
     let helper = if w[0].abs() < 0.9 {
         [1.0, 0.0, 0.0]
     } else {
         [0.0, 1.0, 0.0]
     };
-    let u = normalised(cross(&helper, &w));
-    let v = cross(&w, &u);
+    let u = normalize(cross(helper, w));
+    let v = cross(w, u);
     // Image coordinates and depth (larger is nearer the camera).
     let image: Vec<[f64; 3]> = whole
         .vertices
         .iter()
-        .map(|p| [dot(p, &u), dot(p, &v), dot(p, &w)])
+        .map(|&p| [dot(p, u), dot(p, v), dot(p, w)])
         .collect();
-    let (lo_u, hi_u) = extent_along(&whole.vertices, &u);
-    let (lo_v, hi_v) = extent_along(&whole.vertices, &v);
-    let (lo_w, hi_w) = extent_along(&whole.vertices, &w);
+    let (lo_u, hi_u) = extent_along(&whole.vertices, u);
+    let (lo_v, hi_v) = extent_along(&whole.vertices, v);
+    let (lo_w, hi_w) = extent_along(&whole.vertices, w);
     let cells = resolution.clamp(2, MAX_RESOLUTION);
     let size = (hi_u - lo_u).max(hi_v - lo_v).max(f64::MIN_POSITIVE) / (cells - 1) as f64;
     let cell_of = |x: f64, lo: f64| (((x - lo) / size).round().max(0.0) as usize).min(cells - 1);
@@ -175,33 +171,16 @@ pub fn seen_from(whole: &FigureMesh, view: [f64; 3], resolution: usize) -> Part 
         .collect();
     keep_triangles(whole, |t| {
         let [a, b, c] = t.map(|k| whole.vertices[k as usize]);
-        let facing = dot(&cross(&sub(&b, &a), &sub(&c, &a)), &w) > 0.0;
+        let facing = dot(cross(sub(b, a), sub(c, a)), w) > 0.0;
         facing && t.iter().all(|&k| seen[k as usize])
     })
 }
 
-fn extent_along(points: &[[f64; 3]], axis: &[f64; 3]) -> (f64, f64) {
+fn extent_along(points: &[[f64; 3]], axis: [f64; 3]) -> (f64, f64) {
     points
         .iter()
-        .map(|p| dot(p, axis))
+        .map(|&p| dot(p, axis))
         .fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)))
-}
-
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| a[i] - b[i])
-}
-
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalised(a: [f64; 3]) -> [f64; 3] {
-    let l = dot(&a, &a).sqrt().max(f64::MIN_POSITIVE);
-    a.map(|x| x / l)
 }
 
 #[cfg(test)]
@@ -216,17 +195,6 @@ mod tests {
             ..Default::default()
         })
         .unwrap()
-    }
-
-    fn area(m: &FigureMesh) -> f64 {
-        m.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| m.vertices[k as usize]);
-                let n = cross(&sub(&b, &a), &sub(&c, &a));
-                0.5 * dot(&n, &n).sqrt()
-            })
-            .sum()
     }
 
     /// Every part vertex sits where its whole vertex does, and the part's faces are the
@@ -248,10 +216,10 @@ mod tests {
         let whole = humanoid();
         let part = cut_below(&whole, 1.0 / 3.0);
         assert_exact_truth(&whole, &part);
-        let (lo, hi) = extent_along(&whole.vertices, &[0.0, 1.0, 0.0]);
+        let (lo, hi) = extent_along(&whole.vertices, [0.0, 1.0, 0.0]);
         let level = lo + (hi - lo) / 3.0;
         assert!(part.mesh.vertices.iter().all(|p| p[1] >= level));
-        let share = area(&part.mesh) / area(&whole);
+        let share = part.mesh.area() / whole.area();
         assert!((0.5..0.9).contains(&share), "area kept {share}");
     }
 
@@ -260,11 +228,11 @@ mod tests {
         let whole = humanoid();
         let limb = cut_extremity(&whole, 0.3);
         assert_exact_truth(&whole, &limb);
-        let share = area(&limb.mesh) / area(&whole);
+        let share = limb.mesh.area() / whole.area();
         assert!((0.6..0.99).contains(&share), "area kept {share}");
         let holes = with_holes(&whole, 4, 0.05, 7);
         assert_exact_truth(&whole, &holes);
-        let share = area(&holes.mesh) / area(&whole);
+        let share = holes.mesh.area() / whole.area();
         assert!((0.7..0.99).contains(&share), "area kept {share}");
         assert_eq!(
             with_holes(&whole, 4, 0.05, 7).whole_vertex,
@@ -277,7 +245,7 @@ mod tests {
         let whole = humanoid();
         let front = seen_from(&whole, [0.0, 0.0, 1.0], 256);
         assert_exact_truth(&whole, &front);
-        let share = area(&front.mesh) / area(&whole);
+        let share = front.mesh.area() / whole.area();
         assert!((0.3..0.6).contains(&share), "area seen {share}");
         // The figure faces +z: what the camera in front sees lies in front.
         let mean_z =
@@ -287,19 +255,13 @@ mod tests {
         // From the side, the near arm and leg hide part of the far ones: fewer faces are
         // seen than are turned towards the camera.
         let side = [1.0, 0.0, 0.0];
-        let seen = area(&seen_from(&whole, side, 256).mesh);
-        let turned = area(
-            &keep_triangles(&whole, |t| {
-                let [a, b, c] = t.map(|k| whole.vertices[k as usize]);
-                dot(&cross(&sub(&b, &a), &sub(&c, &a)), &side) > 0.0
-            })
-            .mesh,
-        );
-        eprintln!(
-            "front {share} side seen {} turned {}",
-            seen / area(&whole),
-            turned / area(&whole)
-        );
+        let seen = seen_from(&whole, side, 256).mesh.area();
+        let turned = keep_triangles(&whole, |t| {
+            let [a, b, c] = t.map(|k| whole.vertices[k as usize]);
+            dot(cross(sub(b, a), sub(c, a)), side) > 0.0
+        })
+        .mesh
+        .area();
         assert!(seen < 0.9 * turned, "seen {seen}, turned {turned}");
     }
 }

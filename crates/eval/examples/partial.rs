@@ -11,7 +11,7 @@
 
 use shapecorr::evaluation::pointwise_errors;
 use shapecorr::geodesic::HeatGeodesics;
-use shapecorr::synth::{self, FigureKind, FigureMesh, Part};
+use shapecorr::synth::{self, FigureKind, Part};
 use shapecorr::{NoProgress, PointwiseCorrespondence, Shape};
 
 /// A pair fails above this mean error (as the partial-shapes issue's targets).
@@ -41,6 +41,7 @@ fn main() -> shapecorr::Result<()> {
         let a = Shape::mesh(meshes[0].vertices.clone(), &meshes[0].triangles)?;
         let heat = HeatGeodesics::new(&a)?;
         let area_a = a.mesh_area();
+        let mirror = synth::mirror_map(&meshes[0]);
         for (pose, whole) in meshes.iter().enumerate().skip(1) {
             for (v, variant) in VARIANTS.iter().enumerate() {
                 let seed = (pose * 31 + v) as u64;
@@ -60,7 +61,7 @@ fn main() -> shapecorr::Result<()> {
                 } else {
                     Shape::mesh(part.mesh.vertices.clone(), &part.mesh.triangles)?
                 };
-                let kept = area_of(&part.mesh) / area_of(whole);
+                let kept = part.mesh.area() / whole.area();
                 let line = match PointwiseCorrespondence::compute(
                     &a,
                     &b,
@@ -75,7 +76,6 @@ fn main() -> shapecorr::Result<()> {
                         let map = &result.map.p2p_ba;
                         let mut error = mean(&pointwise_errors(&heat, area_a, &truth, &[map])?[0]);
                         if variant.contains("cloud") {
-                            let mirror = synth::mirror_map(&meshes[0]);
                             let flipped: Vec<u32> =
                                 map.iter().map(|&x| mirror[x as usize]).collect();
                             let e = mean(&pointwise_errors(&heat, area_a, &truth, &[&flipped])?[0]);
@@ -122,23 +122,4 @@ fn view(kind: FigureKind) -> [f64; 3] {
 
 fn mean(e: &[f64]) -> f64 {
     e.iter().sum::<f64>() / e.len().max(1) as f64
-}
-
-fn area_of(m: &FigureMesh) -> f64 {
-    m.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|k| m.vertices[k as usize]);
-            let (u, v): ([f64; 3], [f64; 3]) = (
-                std::array::from_fn(|i| b[i] - a[i]),
-                std::array::from_fn(|i| c[i] - a[i]),
-            );
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
-        })
-        .sum()
 }
