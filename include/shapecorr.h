@@ -125,6 +125,20 @@
 // consistent answers, the one that implies the least turn is taken.
 #define SC_PLACEMENT_TRUST 2
 
+// Option `partial`: B is taken as a part of A when measured so (the default;
+// docs/partial.md).
+#define SC_PARTIAL_AUTO 0
+
+// Option `partial`: both shapes are whole.
+#define SC_PARTIAL_OFF 1
+
+// Option `partial`: B is a part of A (a scan of one side, a body cut off by the field of
+// view).
+#define SC_PARTIAL_B_IN_A 2
+
+// Option `partial`: A is a part of B.
+#define SC_PARTIAL_A_IN_B 3
+
 // Most landmark pairs `sc_params_set_landmarks` accepts.
 #define SC_MAX_LANDMARKS 100
 

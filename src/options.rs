@@ -17,6 +17,7 @@
 use std::fmt;
 
 use crate::maps::fmap::ZoomOutParams;
+use crate::maps::partial::{PartialOption, PARTIAL_NAMES};
 use crate::maps::placement::{Placement, PLACEMENT_NAMES};
 use crate::maps::pointwise::{PointwiseParams, Refinement, RegionConstraints};
 use crate::pipeline::Params;
@@ -607,6 +608,15 @@ pub const OPTIONS: &[OptionInfo] = &[
         ),
     )
     .with_choices(&PLACEMENT_NAMES),
+    regions(
+        "partial",
+        "whether one shape is a part of the other: 0 auto (measured), 1 off (both whole), 2 b_in_a, 3 a_in_b",
+        Field::Int(
+            |p: &Params| p.partial as i64,
+            |p: &mut Params, v| p.partial = PartialOption::ALL[v as usize],
+        ),
+    )
+    .with_choices(&PARTIAL_NAMES),
 ];
 
 /// The option called `name`.
@@ -1118,7 +1128,8 @@ mod tests {
             [
                 ("p2p_regions", &P2P_REGIONS_NAMES[..]),
                 ("p2p_refinement", &P2P_REFINEMENT_NAMES[..]),
-                ("placement", &PLACEMENT_NAMES[..])
+                ("placement", &PLACEMENT_NAMES[..]),
+                ("partial", &PARTIAL_NAMES[..])
             ]
         );
         for info in OPTIONS.iter().filter(|o| !o.choices.is_empty()) {
@@ -1166,10 +1177,7 @@ mod tests {
     #[test]
     fn orientation_is_the_pointwise_params_switch() {
         let last = OPTIONS.last().unwrap();
-        assert_eq!(
-            (last.name, last.option_type),
-            ("placement", OptionType::Int)
-        );
+        assert_eq!((last.name, last.option_type), ("partial", OptionType::Int));
         assert!(Options::default().pointwise().hypotheses);
         let mut options = Options::default();
         assert_eq!(

@@ -35,6 +35,16 @@ pub const SC_PLACEMENT_IGNORE: i64 = 1;
 /// Option `placement`: the shapes stand alike (one scene, one scanner rig); among the
 /// consistent answers, the one that implies the least turn is taken.
 pub const SC_PLACEMENT_TRUST: i64 = 2;
+/// Option `partial`: B is taken as a part of A when measured so (the default;
+/// docs/partial.md).
+pub const SC_PARTIAL_AUTO: i64 = 0;
+/// Option `partial`: both shapes are whole.
+pub const SC_PARTIAL_OFF: i64 = 1;
+/// Option `partial`: B is a part of A (a scan of one side, a body cut off by the field of
+/// view).
+pub const SC_PARTIAL_B_IN_A: i64 = 2;
+/// Option `partial`: A is a part of B.
+pub const SC_PARTIAL_A_IN_B: i64 = 3;
 /// Most landmark pairs `sc_params_set_landmarks` accepts.
 pub const SC_MAX_LANDMARKS: usize = 100;
 
@@ -406,6 +416,21 @@ mod tests {
     use super::*;
     use crate::maps::placement::Placement;
     use crate::options::OPTIONS;
+
+    #[test]
+    fn header_partial_constants_match_the_option() {
+        use crate::maps::partial::PartialOption;
+        let option = OPTIONS.iter().find(|o| o.name == "partial").unwrap();
+        for (value, name) in [
+            (SC_PARTIAL_AUTO, "auto"),
+            (SC_PARTIAL_OFF, "off"),
+            (SC_PARTIAL_B_IN_A, "b_in_a"),
+            (SC_PARTIAL_A_IN_B, "a_in_b"),
+        ] {
+            assert_eq!(option.choices[value as usize], name);
+            assert_eq!(PartialOption::ALL[value as usize] as i64, value);
+        }
+    }
 
     #[test]
     fn header_placement_constants_match_the_option() {

@@ -735,9 +735,36 @@ pub fn zoomout(
     params: &ZoomOutParams,
     cancel: &Cancel,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
-    let run = ZoomOutRun::new(fmap_ab, (a, b), params, cancel)?;
+    zoomout_sloped(fmap_ab, (a, b), params, 1.0, cancel)
+}
+
+/// [`zoomout`] for a map between a part and a whole: B's basis grows `slope` times as fast
+/// as A's (`slope` < 1 when B is a part of A: its share of A's area; > 1 when A is a part
+/// of B), so the map stays on the slanted diagonal of a partial functional map (Rodolà et
+/// al., "Partial Functional Correspondence", CGF 2017, section 4: by Weyl's law a part of
+/// area share `s` has about `s` times as many eigenvalues below any bound). `params.k_end`
+/// is the larger side's final size.
+pub fn zoomout_sloped(
+    fmap_ab: MatRef<'_, f64>,
+    (a, b): (BasisRef<'_>, BasisRef<'_>),
+    params: &ZoomOutParams,
+    slope: f64,
+    cancel: &Cancel,
+) -> Result<(Mat<f64>, Vec<u32>)> {
+    let run = ZoomOutRun::new(fmap_ab, (a, b), params, slope, cancel)?;
     let p2p_ba = fmap_to_p2p(run.fmap_ab.as_ref(), a.0, b.0, cancel)?;
     Ok((run.fmap_ab, p2p_ba))
+}
+
+/// The sizes `(k_b, k_a)` of a map whose larger side has `k` eigenfunctions, on the slanted
+/// diagonal of `slope` ([`zoomout_sloped`]); each at least 1.
+fn sloped_sizes(k: usize, slope: f64) -> (usize, usize) {
+    let smaller = |k: usize, ratio: f64| ((k as f64 * ratio).round() as usize).clamp(1, k);
+    if slope <= 1.0 {
+        (smaller(k, slope), k)
+    } else {
+        (k, smaller(k, 1.0 / slope))
+    }
 }
 
 /// A shape's eigenbasis (one row per vertex) and its vertex masses.
@@ -767,7 +794,7 @@ pub fn zoomout_on_samples(
     params: &ZoomOutParams,
     cancel: &Cancel,
 ) -> Result<SampledZoomOut> {
-    let run = ZoomOutRun::new(fmap_ab, bases, params, cancel)?;
+    let run = ZoomOutRun::new(fmap_ab, bases, params, 1.0, cancel)?;
     let (sub_a, sub_b) = (run.sub_a.as_ref(), run.sub_b.as_ref());
     let p2p_sub = fmap_to_p2p(run.fmap_ab.as_ref(), sub_a, sub_b, cancel)?;
     Ok(SampledZoomOut {
@@ -793,28 +820,33 @@ impl ZoomOutRun {
         fmap_ab: MatRef<'_, f64>,
         ((phi_a, mass_a), (phi_b, mass_b)): (BasisRef<'_>, BasisRef<'_>),
         params: &ZoomOutParams,
+        slope: f64,
         cancel: &Cancel,
     ) -> Result<ZoomOutRun> {
         let k_max = phi_a.ncols().min(phi_b.ncols());
+        let start = fmap_ab.nrows().max(fmap_ab.ncols());
         if params.step == 0
             || params.k_end > k_max
             || params.k_end < fmap_ab.nrows().min(fmap_ab.ncols())
+            || !(slope > 0.0 && slope.is_finite())
         {
             return Err(Error::InvalidParameter {
                 name: "zoomout",
                 reason: format!(
-                    "need step >= 1 and start ({}) <= k_end ({}) <= eigenpairs ({k_max})",
+                    "need step >= 1, start ({}) <= k_end ({}) <= eigenpairs ({k_max}) and a \
+                     finite slope > 0 (got {slope})",
                     fmap_ab.nrows().min(fmap_ab.ncols()),
                     params.k_end
                 ),
             });
         }
+        let (k_end_b, k_end_a) = sloped_sizes(params.k_end, slope);
         let sample_a = Sample::of_size(mass_a, params.sample_size, SAMPLE_SEED);
         let sample_b = Sample::of_size(mass_b, params.sample_size, SAMPLE_SEED + 1);
-        let sub_a = sample_a.rows(phi_a, params.k_end);
-        let sub_b = sample_b.rows(phi_b, params.k_end);
+        let sub_a = sample_a.rows(phi_a, k_end_a);
+        let sub_b = sample_b.rows(phi_b, k_end_b);
         let mut fmap = fmap_ab.to_owned();
-        let mut k = fmap.nrows().min(fmap.ncols());
+        let mut k = start.min(params.k_end);
         while k < params.k_end {
             // Pointwise map on the samples with the current map, then the functional map one
             // step larger from it.
@@ -825,7 +857,7 @@ impl ZoomOutRun {
                 phi_a,
                 sub_b.as_ref(),
                 &sample_b.weights,
-                k,
+                sloped_sizes(k, slope),
             )?;
         }
         Ok(ZoomOutRun {
@@ -838,21 +870,21 @@ impl ZoomOutRun {
     }
 }
 
-/// `C_ab (k x k)` from a pointwise map given on sample rows of shape B: the weighted least
-/// squares `min_C sum_i w_i |Phi_b[i] C - Phi_a[p2p(i)]|^2`, which is exactly
+/// `C_ab (k_b x k_a)` from a pointwise map given on sample rows of shape B: the weighted
+/// least squares `min_C sum_i w_i |Phi_b[i] C - Phi_a[p2p(i)]|^2`, which is exactly
 /// `Phi_b^T M_b Pi Phi_a` when the sample is every vertex weighted by its mass.
 fn weighted_fmap(
     p2p_ba: &[u32],
     phi_a: MatRef<'_, f64>,
     rows_b: MatRef<'_, f64>,
     weights: &[f64],
-    k: usize,
+    (k_b, k_a): (usize, usize),
 ) -> Result<Mat<f64>> {
     let m = p2p_ba.len();
-    let pulled = Mat::from_fn(m, k, |i, j| phi_a[(p2p_ba[i] as usize, j)]);
-    let rows_b = rows_b.subcols(0, k);
-    let weighted = Mat::from_fn(m, k, |i, j| weights[i] * rows_b[(i, j)]);
-    let mut gram = Mat::<f64>::zeros(k, k);
+    let pulled = Mat::from_fn(m, k_a, |i, j| phi_a[(p2p_ba[i] as usize, j)]);
+    let rows_b = rows_b.subcols(0, k_b);
+    let weighted = Mat::from_fn(m, k_b, |i, j| weights[i] * rows_b[(i, j)]);
+    let mut gram = Mat::<f64>::zeros(k_b, k_b);
     matmul(
         gram.as_mut(),
         Accum::Replace,
@@ -861,7 +893,7 @@ fn weighted_fmap(
         1.0,
         Par::Seq,
     );
-    let mut rhs = Mat::<f64>::zeros(k, k);
+    let mut rhs = Mat::<f64>::zeros(k_b, k_a);
     matmul(
         rhs.as_mut(),
         Accum::Replace,
@@ -873,7 +905,7 @@ fn weighted_fmap(
     let llt = gram.llt(Side::Lower).map_err(|e| Error::Numerical {
         stage: "ZoomOut",
         reason: format!(
-            "the sample does not determine {k} eigenfunctions ({e:?}): use a larger sample"
+            "the sample does not determine {k_b} eigenfunctions ({e:?}): use a larger sample"
         ),
     })?;
     Ok(llt.solve(rhs.as_ref()))
@@ -910,7 +942,13 @@ pub fn icp_refine(
     let mut p2p = convert(&fmap, sub_a.as_ref(), sub_b.as_ref())?;
     for _ in 0..iterations {
         let vertices = sample_a.on_vertices(&p2p);
-        let c = weighted_fmap(&vertices, phi_a, sub_b.as_ref(), &sample_b.weights, k_a)?;
+        let c = weighted_fmap(
+            &vertices,
+            phi_a,
+            sub_b.as_ref(),
+            &sample_b.weights,
+            (k_a, k_a),
+        )?;
         let svd = c.svd().map_err(|e| Error::Numerical {
             stage: "spectral ICP",
             reason: format!("{e:?}"),

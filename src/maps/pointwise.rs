@@ -18,6 +18,7 @@ use crate::maps::fmap::{
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, Decision, HypothesisKind, RegionGroups, Verdict};
 use crate::maps::landmarks::{landmark_error, Landmark};
+use crate::maps::partial::PartialReport;
 use crate::maps::placement::{self, Guidance, Placement};
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::regions::RegionMatches;
@@ -210,6 +211,12 @@ pub struct PointwiseMap {
     pub other_p2p_ba: Option<Vec<u32>>,
     /// Seconds of the first functional map and of its refinement.
     pub timings: PointwiseTimings,
+    /// Whether B was taken as a part of A (or A of B), and what was measured
+    /// ([`crate::maps::partial`]).
+    pub partial: PartialReport,
+    /// For every vertex of A, whether B's image covers it ([`crate::maps::partial::covered`]);
+    /// empty until the job sets it.
+    pub covered_a: Vec<bool>,
 }
 
 impl PointwiseMap {
@@ -369,17 +376,7 @@ impl PointwiseMap {
             let (fmap_ab, p2p_ba) = refine(&fmaps[0], (basis_a, basis_b), (params, k), cancel)?;
             (fmap_ab, p2p_ba, None)
         };
-        let mut other_p2p_ba = match verdict.as_ref().and_then(Verdict::runner_up) {
-            Some(h) => Some(fmap_to_p2p(
-                verdict.as_ref().expect("a runner-up has a verdict").scores[h]
-                    .fmap_ab
-                    .as_ref(),
-                basis_a.vectors.as_ref(),
-                basis_b.vectors.as_ref(),
-                cancel,
-            )?),
-            None => None,
-        };
+        let mut other_p2p_ba = runner_up_map(verdict.as_ref(), (basis_a, basis_b), cancel)?;
         for map in std::iter::once(&mut p2p_ba).chain(other_p2p_ba.as_mut()) {
             pin_landmarks(map, &guidance.landmarks);
         }
@@ -392,8 +389,23 @@ impl PointwiseMap {
                 fmap: t_fmap,
                 refinement: t.elapsed().as_secs_f64(),
             },
+            partial: PartialReport::default(),
+            covered_a: Vec::new(),
         })
     }
+}
+
+/// The runner-up's vertex map ([`Verdict::runner_up`]); None when there is none.
+fn runner_up_map(
+    verdict: Option<&Verdict>,
+    (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
+    cancel: &Cancel,
+) -> Result<Option<Vec<u32>>> {
+    let Some((verdict, h)) = verdict.and_then(|v| Some((v, v.runner_up()?))) else {
+        return Ok(None);
+    };
+    let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
+    fmap_to_p2p(verdict.scores[h].fmap_ab.as_ref(), phi_a, phi_b, cancel).map(Some)
 }
 
 /// The region constraints of the map: the groups of matched regions (none for

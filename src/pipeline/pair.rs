@@ -8,6 +8,7 @@
 use std::time::Instant;
 
 use crate::maps::landmarks::check_landmarks;
+use crate::maps::partial;
 use crate::maps::pointwise::{pin_landmarks, PointwiseMap, PointwiseParams, Refinement};
 use crate::pipeline::budget::{regions_job, Budget, Estimate, Job};
 use crate::pipeline::correspondence::Correspondence;
@@ -540,6 +541,8 @@ fn on_ready(
         for p2p in std::iter::once(&mut map.p2p_ba).chain(map.other_p2p_ba.as_mut()) {
             pin_landmarks(p2p, &job.params.landmarks);
         }
+        let n_b = b.shape.active_vertices().len();
+        map.covered_a = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
     }
     let proxies_s = if a.proxy.is_some() || b.proxy.is_some() {
         t.elapsed().as_secs_f64()

@@ -3,6 +3,7 @@
 //! defaults from here.
 
 use crate::maps::landmarks::Landmark;
+use crate::maps::partial::PartialOption;
 use crate::maps::placement::{Guidance, Placement};
 use crate::pipeline::budget::Budget;
 use crate::pipeline::multiresolution::Multiresolution;
@@ -56,6 +57,9 @@ pub struct Params {
     /// [`crate::maps::landmarks::MAX_LANDMARKS`] ([`crate::maps::landmarks`]). Checked
     /// against the shapes when the job starts.
     pub landmarks: Vec<Landmark>,
+    /// Whether one shape is a part of the other (docs/partial.md): `Auto` takes B as a part
+    /// of A when the first map leaves much of A uncovered and B has more open boundary.
+    pub partial: PartialOption,
     /// Keeps the struct open to new fields: build it with `..Default::default()`.
     #[doc(hidden)]
     pub non_exhaustive: crate::NonExhaustive,
@@ -83,6 +87,7 @@ impl Default for Params {
             multiresolution: Multiresolution::default(),
             budget: Budget::default(),
             placement: Placement::Auto,
+            partial: PartialOption::Auto,
             landmarks: Vec::new(),
             non_exhaustive: crate::NonExhaustive(()),
         }

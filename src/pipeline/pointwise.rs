@@ -3,13 +3,14 @@
 
 use crate::maps::fmap::ZoomOutParams;
 use crate::maps::hypotheses::{self, Verdict};
+use crate::maps::partial::{self, Partiality};
 use crate::maps::placement::Guidance;
-use crate::maps::pointwise::{PointwiseMap, PointwiseParams, Refinement};
+use crate::maps::pointwise::{pin_landmarks, PointwiseMap, PointwiseParams, Refinement};
 use crate::pipeline::budget::Estimate;
 use crate::pipeline::correspondence::Correspondence;
 use crate::pipeline::pair::{run_pair, PairJob, PairShapes};
 use crate::pipeline::Params;
-use crate::progress::{check, AsStage, Progress, Stage};
+use crate::progress::{check, polled, AsStage, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::eigen::{EigenParams, Eigenbasis, ShapeBasis};
 use crate::{Error, Result};
@@ -164,7 +165,7 @@ pub fn regions_and_map(
         orientation: pointwise.orientation && params.verify_hypotheses,
         ..pointwise.clone()
     };
-    let map = PointwiseMap::guided(
+    let mut map = PointwiseMap::guided(
         a,
         b,
         Some(regions.matches_view()),
@@ -172,6 +173,7 @@ pub fn regions_and_map(
         &params.guidance(),
         progress,
     )?;
+    with_partiality((a, b), &mut map, params, &pointwise, progress)?;
     if let Some(verdict) = &map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);
@@ -180,6 +182,48 @@ pub fn regions_and_map(
     check(progress, Stage::PointwiseMap, 1.0)?;
     Ok((regions, map))
 }
+
+/// Decides whether B is a part of A (or A of B) from the map's coverage of A and the
+/// shapes' open boundaries ([`partial::detect`]), and refines a part's map on the slanted
+/// diagonal ([`partial::part_map`]) whose slope is the ratio of the two areas.
+fn with_partiality(
+    (a, b): (ShapeBasis<'_>, ShapeBasis<'_>),
+    map: &mut PointwiseMap,
+    params: &Params,
+    pointwise: &PointwiseParams,
+    progress: &mut dyn Progress,
+) -> Result<()> {
+    let n_b = b.shape.active_vertices().len();
+    let covered = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
+    let share = partial::covered_share(&a.basis.mass, &covered);
+    let boundary = [
+        partial::open_boundary(a.shape),
+        partial::open_boundary(b.shape),
+    ];
+    // A part and its whole are taken to be in the same units, as Rodolà et al. do.
+    let area_share = b.basis.input_area / a.basis.input_area;
+    map.partial = partial::detect(params.partial, share, boundary, area_share);
+    if map.partial.partiality == Partiality::Whole {
+        return Ok(());
+    }
+    let slope = area_share.clamp(MIN_SLOPE, 1.0 / MIN_SLOPE);
+    let zoomout = match &pointwise.refinement {
+        Refinement::ZoomOut(z) => z.clone(),
+        _ => ZoomOutParams::default(),
+    };
+    let started = std::time::Instant::now();
+    let (fmap_ab, p2p_ba) = polled(progress, Stage::PointwiseMap, (0.9, 1.0), |cancel| {
+        partial::part_map((a.basis, b.basis), &map.p2p_ba, slope, &zoomout, cancel)
+    })?;
+    (map.fmap_ab, map.p2p_ba) = (fmap_ab, p2p_ba);
+    pin_landmarks(&mut map.p2p_ba, &params.landmarks);
+    map.timings.refinement += started.elapsed().as_secs_f64();
+    Ok(())
+}
+
+/// The smallest slope of a part's map: a part of a tenth of the whole's area (50 of A's
+/// 100 eigenfunctions would leave B 5).
+const MIN_SLOPE: f64 = 0.1;
 
 /// Verifies the one-to-one answer of `regions` at the map level on the regions' own
 /// eigenbases (ZoomOut up to their size): the hypotheses of [`hypotheses::candidates`] are

@@ -832,6 +832,12 @@ static void test_pointwise_options(void) {
             CHECK(strcmp(sc_option_choice(i, SC_PLACEMENT_IGNORE), "ignore") == 0, "ignore");
             CHECK(strcmp(sc_option_choice(i, SC_PLACEMENT_TRUST), "trust") == 0, "trust");
             CHECK(sc_option_choice(i, 3) == NULL, "past the last choice");
+        } else if (strcmp(name, "partial") == 0) {
+            CHECK(strcmp(sc_option_choice(i, SC_PARTIAL_AUTO), "auto") == 0, "auto");
+            CHECK(strcmp(sc_option_choice(i, SC_PARTIAL_OFF), "off") == 0, "off");
+            CHECK(strcmp(sc_option_choice(i, SC_PARTIAL_B_IN_A), "b_in_a") == 0, "b_in_a");
+            CHECK(strcmp(sc_option_choice(i, SC_PARTIAL_A_IN_B), "a_in_b") == 0, "a_in_b");
+            CHECK(sc_option_choice(i, 4) == NULL, "past the last choice");
         } else {
             CHECK(sc_option_choice(i, 0) == NULL, "%s is not a choice", name);
         }

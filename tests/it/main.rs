@@ -18,6 +18,7 @@ mod limits;
 mod low_poly;
 mod matching;
 mod multiresolution;
+mod partial;
 mod pieces;
 mod point_cloud;
 mod pointwise;

@@ -82,6 +82,7 @@ __all__ = [
     "RegionsChoice",
     "RefinementChoice",
     "PlacementChoice",
+    "PartialChoice",
     "Hypothesis",
     "Working",
     "WorkingKind",
@@ -121,6 +122,8 @@ RegionsChoice = Union[IntValue, Literal["none", "one-to-one", "symmetric"]]
 RefinementChoice = Union[IntValue, Literal["none", "zoomout", "icp"]]
 #: ``placement``: by name, or by value (0, 1, 2); see docs/placement.md.
 PlacementChoice = Union[IntValue, Literal["auto", "ignore", "trust"]]
+#: ``partial``: by name, or by value (0 to 3); see docs/partial.md.
+PartialChoice = Union[IntValue, Literal["auto", "off", "b_in_a", "a_in_b"]]
 #: ``landmarks``: pairs ``(vertex of A, vertex of B)``, a sequence of pairs of non-negative
 #: integers or an (n, 2) integer array.
 Landmarks = Union[Iterable[Iterable[IntValue]], "NDArray[np.integer[Any]]"]
@@ -159,6 +162,7 @@ class RegionOptions(TypedDict, total=False):
     memory_limit_mib: IntValue
     time_limit_s: FloatValue
     placement: PlacementChoice
+    partial: PartialChoice
 
 
 class PointwiseOptions(RegionOptions, total=False):

@@ -143,8 +143,9 @@ def test_options_and_defaults():
     assert info["placement"].choices == ("auto", "ignore", "trust")
     assert info["placement"].default == _lib.PLACEMENT_AUTO
     assert [o.name for o in shapecorr.options() if o.choices] == [
-        "p2p_regions", "p2p_refinement", "placement"
+        "p2p_regions", "p2p_refinement", "placement", "partial"
     ]
+    assert info["partial"].choices == ("auto", "off", "b_in_a", "a_in_b")
 
 
 def read_back(options, name):

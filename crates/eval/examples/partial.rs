@@ -7,10 +7,11 @@
 //! above 0.1; the flip allowed for clouds). Prints a line per pair (error, the share of the
 //! whole's area B keeps, confidence) and a summary per variant: mean, median, worst, failed.
 //!
-//!     cargo run --release -p shapecorr-eval --example partial -- [--vertices N]
+//!     cargo run --release -p shapecorr-eval --example partial -- [--vertices N] [--partial auto|off|b_in_a]
 
 use shapecorr::evaluation::pointwise_errors;
 use shapecorr::geodesic::HeatGeodesics;
+use shapecorr::maps::partial::Partiality;
 use shapecorr::synth::{self, FigureKind, Part};
 use shapecorr::{NoProgress, PointwiseCorrespondence, Shape};
 
@@ -28,13 +29,23 @@ const VARIANTS: [&str; 5] = [
 fn main() -> shapecorr::Result<()> {
     let mut args = std::env::args().skip(1);
     let mut vertices = 5_000usize;
+    let mut params = shapecorr::Params::default();
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--vertices" => vertices = args.next().and_then(|s| s.parse().ok()).unwrap_or(5_000),
+            "--partial" => {
+                let value = shapecorr::options::parse_option_value(
+                    "partial",
+                    &args.next().unwrap_or_default(),
+                )?;
+                params.set_option("partial", value)?;
+            }
             other => panic!("unknown argument {other}"),
         }
     }
     let mut errors: Vec<Vec<f64>> = vec![Vec::new(); VARIANTS.len()];
+    let mut mask_right: Vec<Vec<f64>> = vec![Vec::new(); VARIANTS.len()];
+    let mut calls = [0usize; VARIANTS.len()];
     for kind in [FigureKind::Humanoid, FigureKind::Quadruped] {
         let poses: Vec<usize> = (0..synth::n_poses(kind)).collect();
         let meshes = synth::figure_poses(kind, vertices, Default::default(), &poses)?;
@@ -65,7 +76,7 @@ fn main() -> shapecorr::Result<()> {
                 let line = match PointwiseCorrespondence::compute(
                     &a,
                     &b,
-                    &Default::default(),
+                    &params,
                     &Default::default(),
                     &mut NoProgress,
                 ) {
@@ -82,11 +93,28 @@ fn main() -> shapecorr::Result<()> {
                             error = error.min(e);
                         }
                         errors[v].push(error);
+                        let mut truly_covered = vec![false; a.n_vertices()];
+                        for &w in &part.whole_vertex {
+                            truly_covered[w as usize] = true;
+                        }
+                        let mask = &result.map.covered_a;
+                        let right = (mask.iter().zip(&truly_covered))
+                            .filter(|(m, t)| m == t)
+                            .count() as f64
+                            / a.n_vertices() as f64;
+                        mask_right[v].push(right);
+                        let report = &result.map.partial;
+                        calls[v] += usize::from(report.partiality != Partiality::Whole);
                         format!(
-                            "{error:.4} confidence {}",
+                            "{error:.4} confidence {} taken as {} (covered {:.2}, boundary \
+                             {:.2} {:.2}) mask right {right:.3}",
                             result
                                 .confidence()
-                                .map_or("-".into(), |c| format!("{c:.2}"))
+                                .map_or("-".into(), |c| format!("{c:.2}")),
+                            report.partiality.name(),
+                            report.covered_share,
+                            report.boundary[0],
+                            report.boundary[1],
                         )
                     }
                     Err(e) => {
@@ -98,15 +126,22 @@ fn main() -> shapecorr::Result<()> {
             }
         }
     }
-    for (variant, e) in VARIANTS.iter().zip(&mut errors) {
+    for (v, (variant, e)) in VARIANTS.iter().zip(&mut errors).enumerate() {
         e.sort_by(f64::total_cmp);
+        let right = &mut mask_right[v];
+        right.sort_by(f64::total_cmp);
         println!(
-            "{variant:>15}: mean {:.4} median {:.4} worst {:.4} failed {}/{}",
+            "{variant:>15}: mean {:.4} median {:.4} worst {:.4} failed {}/{}; taken as a part \
+             {}/{}; mask right mean {:.3} worst {:.3}",
             mean(e),
             e[e.len() / 2],
             e[e.len() - 1],
             e.iter().filter(|&&x| x > FAILED).count(),
-            e.len()
+            e.len(),
+            calls[v],
+            e.len(),
+            mean(right),
+            right.first().copied().unwrap_or(f64::NAN),
         );
     }
     Ok(())
