@@ -756,6 +756,15 @@ pub fn zoomout_sloped(
     Ok((run.fmap_ab, p2p_ba))
 }
 
+/// The first rows (B's side) or columns (A's side) of a square map, as many as the slanted
+/// diagonal of `slope` keeps ([`zoomout_sloped`]).
+pub fn slanted(fmap_ab: MatRef<'_, f64>, slope: f64) -> Mat<f64> {
+    let k = fmap_ab.nrows().max(fmap_ab.ncols());
+    let (k_b, k_a) = sloped_sizes(k, slope);
+    let (k_b, k_a) = (k_b.min(fmap_ab.nrows()), k_a.min(fmap_ab.ncols()));
+    fmap_ab.submatrix(0, 0, k_b, k_a).to_owned()
+}
+
 /// The sizes `(k_b, k_a)` of a map whose larger side has `k` eigenfunctions, on the slanted
 /// diagonal of `slope` ([`zoomout_sloped`]); each at least 1.
 fn sloped_sizes(k: usize, slope: f64) -> (usize, usize) {
@@ -785,16 +794,17 @@ pub struct SampledZoomOut {
     pub p2p_ba: Vec<u32>,
 }
 
-/// [`zoomout`] up to, not including, the full-resolution conversion (for comparing
-/// candidate maps before paying for it).
+/// [`zoomout_sloped`] up to, not including, the full-resolution conversion (for comparing
+/// candidate maps before paying for it); `slope` 1 for two whole shapes.
 /// Honours `cancel` as [`zoomout`] does.
 pub fn zoomout_on_samples(
     fmap_ab: MatRef<'_, f64>,
     bases: (BasisRef<'_>, BasisRef<'_>),
     params: &ZoomOutParams,
+    slope: f64,
     cancel: &Cancel,
 ) -> Result<SampledZoomOut> {
-    let run = ZoomOutRun::new(fmap_ab, bases, params, 1.0, cancel)?;
+    let run = ZoomOutRun::new(fmap_ab, bases, params, slope, cancel)?;
     let (sub_a, sub_b) = (run.sub_a.as_ref(), run.sub_b.as_ref());
     let p2p_sub = fmap_to_p2p(run.fmap_ab.as_ref(), sub_a, sub_b, cancel)?;
     Ok(SampledZoomOut {

@@ -1,6 +1,7 @@
-//! Partial shapes (docs/partial.md): which of A's vertices a map from B covers, whether B is
-//! a part of A (or A of B), and the map of a part refined on the slanted diagonal of a
-//! partial functional map (Rodolà et al., "Partial Functional Correspondence", CGF 2017).
+//! Partial shapes (docs/partial.md): whether B is a part of A (or A of B), whose map is then
+//! refined on the slanted diagonal of a partial functional map (Rodolà et al., "Partial
+//! Functional Correspondence", CGF 2017; [`crate::maps::fmap::zoomout_sloped`]), and which
+//! of A's vertices a map from B covers.
 
 use faer::Mat;
 
@@ -91,7 +92,8 @@ pub struct PartialReport {
     pub partiality: Partiality,
     /// The `partial` option decided (not the measurement).
     pub given: bool,
-    /// The share of A's area that the first map covers ([`covered`]), in [0, 1].
+    /// The share of A's area that the map covers ([`covered`]), in [0, 1]; 1 until the
+    /// map is made.
     pub covered_share: f64,
     /// Open boundary length over the square root of the area, of A and of B (0 for a point
     /// cloud).
@@ -165,12 +167,7 @@ pub fn open_boundary(shape: &Shape) -> f64 {
 /// first map covers does not tell: a map of a part smears it over 87-98% of the whole
 /// (docs/partial.md). A part of B as A, and a point cloud as the part, are only taken when
 /// asked for.
-pub fn detect(
-    option: PartialOption,
-    covered_share: f64,
-    boundary: [f64; 2],
-    area_share: f64,
-) -> PartialReport {
+pub fn detect(option: PartialOption, boundary: [f64; 2], area_share: f64) -> PartialReport {
     let (low, high) = PART_AREA_SHARE;
     let looks_like_part =
         boundary[1] > boundary[0] + PART_EXTRA_BOUNDARY && (low..=high).contains(&area_share);
@@ -184,7 +181,7 @@ pub fn detect(
     PartialReport {
         partiality,
         given,
-        covered_share,
+        covered_share: 1.0,
         boundary,
         area_share,
     }
@@ -235,16 +232,16 @@ mod tests {
 
     #[test]
     fn detection_needs_more_boundary_and_a_share_of_the_area() {
-        let auto = |boundary, share| detect(PartialOption::Auto, 1.0, boundary, share);
+        let auto = |boundary, share| detect(PartialOption::Auto, boundary, share);
         assert_eq!(auto([0.0, 1.0], 0.7).partiality, Partiality::BInA);
         // Not enough extra boundary, too much area, too little (other units).
         assert_eq!(auto([0.6, 1.0], 0.7).partiality, Partiality::Whole);
         assert_eq!(auto([0.0, 1.0], 0.95).partiality, Partiality::Whole);
         assert_eq!(auto([0.0, 1.0], 0.01).partiality, Partiality::Whole);
         assert!(!auto([0.0, 1.0], 0.7).given);
-        let told = detect(PartialOption::AInB, 1.0, [0.0, 0.0], 1.0);
+        let told = detect(PartialOption::AInB, [0.0, 0.0], 1.0);
         assert_eq!((told.partiality, told.given), (Partiality::AInB, true));
-        let off = detect(PartialOption::Off, 1.0, [0.0, 1.0], 0.7);
+        let off = detect(PartialOption::Off, [0.0, 1.0], 0.7);
         assert_eq!((off.partiality, off.given), (Partiality::Whole, true));
     }
 

@@ -31,14 +31,19 @@ pub enum Placement {
     Trust,
 }
 
-/// What the user knows beyond the shapes' geometry: how to use where they stand, and
-/// landmark pairs (vertices of the shapes a function is given, A's then B's).
+/// What the user knows beyond the shapes' geometry: how to use where they stand, landmark
+/// pairs (vertices of the shapes a function is given, A's then B's), and whether one shape
+/// is a part of the other.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Guidance {
     /// How the shapes' placement is used.
     pub placement: Placement,
     /// Landmark pairs ([`crate::maps::landmarks`]).
     pub landmarks: Vec<crate::maps::landmarks::Landmark>,
+    /// When one shape is a part of the other, B's area over A's: the maps are then refined
+    /// on the slanted diagonal of that slope ([`crate::maps::fmap::zoomout_sloped`]; with
+    /// ZoomOut only). None for two whole shapes.
+    pub part_slope: Option<f64>,
 }
 
 /// The names of [`Placement`]'s values, by value (0, 1, 2).

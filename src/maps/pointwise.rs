@@ -13,7 +13,8 @@ use rayon::prelude::*;
 
 use crate::maps::fmap::{
     fmap_to_p2p, icp_refine, multiplication_operators, orientation_operators, p2p_to_fmap, project,
-    solve_fmap_commuting, zoomout, zoomout_on_samples, Commutativity, ZoomOutParams,
+    slanted, solve_fmap_commuting, zoomout_on_samples, zoomout_sloped, Commutativity,
+    ZoomOutParams,
 };
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, Decision, HypothesisKind, RegionGroups, Verdict};
@@ -201,7 +202,8 @@ pub struct PointwiseTimings {
 pub struct PointwiseMap {
     /// `p2p_ba[v]`: the vertex of A matched to vertex `v` of B.
     pub p2p_ba: Vec<u32>,
-    /// The final functional map from A to B (`k x k`).
+    /// The final functional map from A to B (`k x k`; `k_b x k_a` on the slanted diagonal
+    /// for a part, [`crate::maps::partial`]).
     pub fmap_ab: Mat<f64>,
     /// The region hypotheses verified at the map level, the chosen one and its confidence
     /// (None when there was one hypothesis only).
@@ -337,6 +339,10 @@ impl PointwiseMap {
             fmaps.push(p2p_to_fmap(&p2p, phi_a, phi_b, &basis_b.mass, k, k));
             kinds.push(HypothesisKind::Placement);
         }
+        let slope = part_slope(params, guidance);
+        if slope != 1.0 {
+            fmaps = fmaps.iter().map(|f| slanted(f.as_ref(), slope)).collect();
+        }
         cancel.set_fraction(0.4);
         let t_fmap = started.elapsed().as_secs_f64();
         let t = Instant::now();
@@ -367,13 +373,14 @@ impl PointwiseMap {
                 _ => refine(
                     &fmaps[verdict.chosen],
                     (basis_a, basis_b),
-                    (params, k),
+                    (params, k, slope),
                     cancel,
                 )?,
             };
             (fmap_ab, p2p_ba, Some(verdict))
         } else {
-            let (fmap_ab, p2p_ba) = refine(&fmaps[0], (basis_a, basis_b), (params, k), cancel)?;
+            let (fmap_ab, p2p_ba) =
+                refine(&fmaps[0], (basis_a, basis_b), (params, k, slope), cancel)?;
             (fmap_ab, p2p_ba, None)
         };
         let mut other_p2p_ba = runner_up_map(verdict.as_ref(), (basis_a, basis_b), cancel)?;
@@ -392,6 +399,15 @@ impl PointwiseMap {
             partial: PartialReport::default(),
             covered_a: Vec::new(),
         })
+    }
+}
+
+/// The slope of the maps' slanted diagonal: the guidance's for a part refined by ZoomOut
+/// (spectral ICP needs a square map), else 1.
+fn part_slope(params: &PointwiseParams, guidance: &Guidance) -> f64 {
+    match (&params.refinement, guidance.part_slope) {
+        (Refinement::ZoomOut(_), Some(slope)) => slope,
+        _ => 1.0,
     }
 }
 
@@ -455,7 +471,7 @@ fn clamped(
 fn refine(
     fmap: &Mat<f64>,
     (basis_a, basis_b): (&Eigenbasis, &Eigenbasis),
-    (params, k): (&PointwiseParams, usize),
+    (params, k, slope): (&PointwiseParams, usize, f64),
     cancel: &Cancel,
 ) -> Result<(Mat<f64>, Vec<u32>)> {
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
@@ -470,7 +486,7 @@ fn refine(
         }
         Refinement::ZoomOut(z) => {
             let z = clamped(z, (basis_a, basis_b), k);
-            zoomout(fmap.as_ref(), bases, &z, cancel)
+            zoomout_sloped(fmap.as_ref(), bases, &z, slope, cancel)
         }
         Refinement::Icp(iterations) => {
             let sample_size = ZoomOutParams::default().sample_size;
@@ -521,7 +537,10 @@ fn verified(
     let decision = clamped(&decision, (basis_a, basis_b), k);
     let sampled = fmaps
         .par_iter()
-        .map(|fmap| zoomout_on_samples(fmap.as_ref(), bases, &decision, cancel))
+        .map(|fmap| {
+            let slope = part_slope(params, guidance);
+            zoomout_on_samples(fmap.as_ref(), bases, &decision, slope, cancel)
+        })
         .collect::<Result<Vec<_>>>()?;
     cancel.check()?;
     let energies = hypotheses::energies(side_a, side_b, faces, &sampled);

@@ -100,6 +100,7 @@ impl Params {
         Guidance {
             placement: self.placement,
             landmarks: self.landmarks.clone(),
+            part_slope: None,
         }
     }
 

@@ -140,6 +140,15 @@ impl Answer<'_> {
             "total": result.total,
         });
         value["fmap_size"] = json!(result.map.fmap_ab.nrows());
+        let partial = &result.map.partial;
+        value["partial"] = json!({
+            "taken_as": partial.partiality.name(),
+            "given": partial.given,
+            "covered_share": partial.covered_share,
+            "open_boundary": partial.boundary,
+            "area_share": partial.area_share,
+            "covered_a": result.map.covered_a.iter().filter(|&&c| c).count(),
+        });
         value["options"] = options_json(self.options, true);
         value["region_times"] = json!(self.pointwise.region_times);
         value["budget"] = budget_json(&result.estimate);

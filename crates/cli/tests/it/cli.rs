@@ -357,6 +357,15 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
                 > 0.0
         );
         assert_eq!(result["regions_b"].as_array().unwrap().len(), n_b);
+        // Two whole figures: not taken as parts, and B's image covers nearly all of A.
+        let partial = &result["partial"];
+        assert_eq!(partial["taken_as"], "whole", "{name}: {partial}");
+        assert_eq!(partial["given"], false);
+        let covered = partial["covered_a"].as_u64().unwrap() as usize;
+        assert!(
+            covered * 10 >= n_a * 9 && covered <= n_a,
+            "{name}: {covered} of {n_a}"
+        );
         let confidence = check_verdict(&result, &String::from_utf8_lossy(&out.stderr));
         assert!(confidence.is_some(), "{name}: verified by default");
         assert!(String::from_utf8_lossy(&out.stdout).contains("confidence "));
