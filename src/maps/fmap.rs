@@ -767,7 +767,7 @@ pub fn slanted(fmap_ab: MatRef<'_, f64>, slope: f64) -> Mat<f64> {
 
 /// The sizes `(k_b, k_a)` of a map whose larger side has `k` eigenfunctions, on the slanted
 /// diagonal of `slope` ([`zoomout_sloped`]); each at least 1.
-fn sloped_sizes(k: usize, slope: f64) -> (usize, usize) {
+pub(crate) fn sloped_sizes(k: usize, slope: f64) -> (usize, usize) {
     let smaller = |k: usize, ratio: f64| ((k as f64 * ratio).round() as usize).clamp(1, k);
     if slope <= 1.0 {
         (smaller(k, slope), k)

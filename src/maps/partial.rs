@@ -6,9 +6,9 @@
 use faer::Mat;
 
 use crate::geodesic::edge_graph_distances;
-use crate::maps::fmap::{p2p_to_fmap, zoomout_sloped, ZoomOutParams};
+use crate::maps::fmap::{p2p_to_fmap, sloped_sizes, zoomout_sloped, ZoomOutParams};
 use crate::progress::Cancel;
-use crate::shape::{Shape, ShapeKind};
+use crate::shape::{distance, Shape, ShapeKind};
 use crate::spectral::eigen::Eigenbasis;
 use crate::Result;
 
@@ -153,9 +153,7 @@ pub fn open_boundary(shape: &Shape) -> f64 {
     for (i, edge) in edges.iter().enumerate() {
         let single = (i == 0 || edges[i - 1] != *edge) && edges.get(i + 1) != Some(edge);
         if single {
-            let (u, v) = (p[edge.0 as usize], p[edge.1 as usize]);
-            length +=
-                ((u[0] - v[0]).powi(2) + (u[1] - v[1]).powi(2) + (u[2] - v[2]).powi(2)).sqrt();
+            length += distance(&p[edge.0 as usize], &p[edge.1 as usize]);
         }
     }
     length / shape.mesh_area().max(f64::MIN_POSITIVE).sqrt()
@@ -202,12 +200,7 @@ pub fn part_map(
     const START: usize = 10;
     let k_end = zoomout.k_end.min(basis_a.len()).min(basis_b.len());
     let start = START.min(k_end);
-    let smaller = ((start as f64 * slope.min(1.0 / slope)).round() as usize).clamp(1, start);
-    let (k_b, k_a) = if slope <= 1.0 {
-        (smaller, start)
-    } else {
-        (start, smaller)
-    };
+    let (k_b, k_a) = sloped_sizes(start, slope);
     let (phi_a, phi_b) = (basis_a.vectors.as_ref(), basis_b.vectors.as_ref());
     let fmap = p2p_to_fmap(p2p_ba, phi_a, phi_b, &basis_b.mass, k_a, k_b);
     let params = ZoomOutParams {

@@ -541,8 +541,11 @@ fn on_ready(
         for p2p in std::iter::once(&mut map.p2p_ba).chain(map.other_p2p_ba.as_mut()) {
             pin_landmarks(p2p, &job.params.landmarks);
         }
-        let n_b = b.shape.active_vertices().len();
-        map.covered_a = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
+        // The mask of the working shapes, again on the input ones when proxies stood in.
+        if a.proxy.is_some() || b.proxy.is_some() {
+            let n_b = b.shape.active_vertices().len();
+            map.covered_a = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
+        }
     }
     let proxies_s = if a.proxy.is_some() || b.proxy.is_some() {
         t.elapsed().as_secs_f64()

@@ -190,6 +190,7 @@ pub fn regions_and_map(
     let covered = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
     partial.covered_share = partial::covered_share(&a.basis.mass, &covered);
     map.partial = partial;
+    map.covered_a = covered;
     if let Some(verdict) = &map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);
