@@ -980,6 +980,34 @@ const char *sc_pointwise_decided_by(const sc_pointwise *pointwise);
 // `pointwise` must be NULL or live.
 bool sc_pointwise_placement_used(const sc_pointwise *pointwise);
 
+// What the pair was taken to be (docs/partial.md, option `partial`): `"whole"`, `"b_in_a"`
+// (B is a part of A) or `"a_in_b"`; static, NULL for NULL. `out_given`, when not NULL, is
+// set to true when the option decided it rather than the measurement.
+//
+// # Safety
+// `pointwise` must be NULL or live; `out_given` NULL or writable.
+const char *sc_pointwise_taken_as(const sc_pointwise *pointwise, bool *out_given);
+
+// The share of A's area that has a counterpart on B under the map, in [0, 1] (near 1 for
+// two whole shapes, the part's share for a part of A); NaN for NULL.
+//
+// # Safety
+// `pointwise` must be NULL or live.
+double sc_pointwise_covered_share(const sc_pointwise *pointwise);
+
+// Copies one side's coverage mask into `out_covered` of `len` elements
+// (`sc_pointwise_n_vertices(p, side)` of them, in the caller's vertex order): for
+// `SC_SIDE_A`, whether B's image covers the vertex; for `SC_SIDE_B`, whether the vertex has
+// a counterpart on A (every vertex, unless A was taken as a part of B). A transfer from A
+// to B should write only B's covered vertices (docs/partial.md).
+//
+// # Safety
+// `pointwise` must be live; `out_covered` must point to `len` writable elements.
+sc_status sc_pointwise_covered(const sc_pointwise *pointwise,
+                               uint32_t side,
+                               bool *out_covered,
+                               size_t len);
+
 // The other answer: a new pointwise map holding the runner-up hypothesis's vertex map (at
 // full resolution), functional map and one-to-one regions, with its verdict (decided by
 // `"other answer"`). Nothing is recomputed: the hypotheses were verified with the first

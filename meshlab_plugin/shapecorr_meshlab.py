@@ -133,9 +133,26 @@ def report(result, shapes=()):
     if result.warning is not None:
         lines.append(f"warning: {result.warning}")
         lines.append(ADVICE)
+    lines.extend(partial_lines(result))
     for side, shape in zip("AB", shapes):
         lines.extend(f"repaired {side}: {repair}" for repair in shape.repairs)
     lines.extend(working_lines(result, shapes))
+    return lines
+
+
+def partial_lines(result):
+    """What a pointwise map took as a part (docs/partial.md): ``partial: B is a part of A
+    (measured), 45% of A covered``, and for A a part of B how many vertices of B have no
+    counterpart; nothing for two whole shapes or a region answer."""
+    taken_as = getattr(result, "taken_as", "whole")
+    if taken_as == "whole":
+        return []
+    how = "given" if result.partial_given else "measured"
+    part, whole = ("B", "A") if taken_as == "b_in_a" else ("A", "B")
+    lines = [f"partial: {part} is a part of {whole} ({how}), {100 * result.covered_share:.0f}% of A covered"]
+    uncovered = int((~result.covered_b).sum())
+    if uncovered:
+        lines.append(f"partial: {uncovered} vertices of B have no counterpart on A; a transfer keeps B's own values there")
     return lines
 
 
@@ -268,6 +285,15 @@ def transfer(ms, id_a=0, id_b=1, colors=True, quality=True, texcoords=True, prog
     pointwise = shapecorr.pointwise_map(*shapes, progress=progress, **options)
     onto = shapecorr.surface_map(*shapes, pointwise, progress=progress)
     values = {name: onto.transfer(array) for name, array in carried.items()}
+    # A vertex of B without a counterpart on A (A a part of B) keeps what B has of it.
+    uncovered = ~pointwise.covered_b
+    own = {"v_color_matrix": (mesh_b.has_vertex_color, mesh_b.vertex_color_matrix),
+           "v_scalar_array": (mesh_b.has_vertex_scalar, mesh_b.vertex_scalar_array),
+           "v_tex_coords_matrix": (mesh_b.has_vertex_tex_coord, mesh_b.vertex_tex_coord_matrix)}
+    for name, array in values.items():
+        has, read = own[name]
+        if uncovered.any() and has():
+            array[uncovered] = read()[uncovered]
     if wedges:
         corners = mesh_a.wedge_tex_coord_matrix().reshape(-1, 3, 2)
         carried_corners = onto.transfer_corners(shapes[0], mesh_a.face_matrix(), corners, mesh_b.face_matrix())

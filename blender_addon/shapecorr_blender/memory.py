@@ -113,6 +113,11 @@ def write_summary(scene, operation, names, result):
     shown.has_runner_up = runner_up is not None
     shown.runner_up = "" if runner_up is None else _field(runner_up, "hypothesis")
     shown.runner_up_cost = 0.0 if runner_up is None else _field(runner_up, "cost")
+    # Only a pointwise map knows whether a shape was taken as a part.
+    partial = hasattr(result, "covered_b")
+    shown.taken_as = result.taken_as if partial else ""
+    shown.covered_share = result.covered_share if partial else 1.0
+    shown.uncovered_target = int((~result.covered_b).sum()) if partial else 0
 
 
 def answer_text(result):

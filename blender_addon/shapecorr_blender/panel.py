@@ -23,6 +23,7 @@ class SHAPECORR_PT_panel(bpy.types.Panel):
         layout.prop(settings, "one_to_one")
         layout.prop(settings, "point_cloud")
         layout.prop(settings, "placement")
+        layout.prop(settings, "partial")
         layout.operator("shapecorr.match_regions", icon="MOD_DATA_TRANSFER")
         problem = selection_problem(context, 2)
         if problem:
@@ -74,6 +75,11 @@ def draw_answer(layout, answer):
     turn = f", turn {answer.turn:.0f}\u00b0" if answer.has_turn else ""
     used = "used" if answer.placement_used else "not used"
     column.label(text=f"Placement: {used}{turn}")
+    if answer.taken_as and answer.taken_as != "whole":
+        part = "target" if answer.taken_as == "b_in_a" else "source"
+        column.label(text=f"Partial: the {part} is a part, {100 * answer.covered_share:.0f}% of the source covered")
+        if answer.uncovered_target:
+            column.label(text=f"{answer.uncovered_target} target vertices without a counterpart")
     if answer.has_runner_up:
         column.label(text=f"Runner-up: {answer.runner_up}, cost {answer.runner_up_cost:.3g}")
     else:

@@ -8,6 +8,17 @@ _OPTIONS = library_options()
 _DEFAULTS = {name: default for name, _kind, _doc, default in _OPTIONS}
 _DOCS = {name: doc for name, _kind, doc, _default in _OPTIONS}
 _PLACEMENTS = {o.name: o for o in _OPTIONS}["placement"].choices
+_PARTIALS = {o.name: o for o in _OPTIONS}["partial"].choices
+#: What each choice of ``partial`` does, for the tooltip (docs/partial.md).
+_PARTIAL_DOCS = {
+    "auto": "Take the target as a part of the source when it has much more open boundary and "
+    "20-80% of its area (a scan with the feet cut off, holes); otherwise both are whole",
+    "off": "Both objects are whole",
+    "b_in_a": "The target is a part of the source (a scan of one side): every target vertex gets "
+    "a value",
+    "a_in_b": "The source is a part of the target: Transfer writes only the target vertices the "
+    "source covers, the others keep what they had",
+}
 #: What each placement does, for the tooltip (docs/placement.md).
 _PLACEMENT_DOCS = {
     "auto": "Use where the two objects stand only when it is informative (one answer implies "
@@ -46,6 +57,9 @@ class ShapecorrAnswer(bpy.types.PropertyGroup):
     has_runner_up: bpy.props.BoolProperty(name="Has Runner-Up")
     runner_up: bpy.props.StringProperty(name="Runner-Up")
     runner_up_cost: bpy.props.FloatProperty(name="Runner-Up Cost")
+    taken_as: bpy.props.StringProperty(name="Taken As", description="whole, b_in_a or a_in_b")
+    covered_share: bpy.props.FloatProperty(name="Covered Share", description="Share of the source's area with a counterpart")
+    uncovered_target: bpy.props.IntProperty(name="Uncovered Target Vertices")
 
 
 class ShapecorrSettings(bpy.types.PropertyGroup):
@@ -82,6 +96,12 @@ class ShapecorrSettings(bpy.types.PropertyGroup):
         "(a half-turn or a mirror that the shapes alone cannot tell apart)",
         items=[(name, name.capitalize(), _PLACEMENT_DOCS[name]) for name in _PLACEMENTS],
         default=_PLACEMENTS[_DEFAULTS["placement"]],
+    )
+    partial: bpy.props.EnumProperty(
+        name="Partial",
+        description="Whether one object is a part of the other (a cut, holes, one side of a scan)",
+        items=[(name, name.replace("_", " ").capitalize(), _PARTIAL_DOCS[name]) for name in _PARTIALS],
+        default=_PARTIALS[_DEFAULTS["partial"]],
     )
     landmarks: bpy.props.CollectionProperty(type=ShapecorrLandmark)
     landmark_index: bpy.props.IntProperty(name="Active Landmark Pair", default=0, min=0)
@@ -142,4 +162,5 @@ class ShapecorrSettings(bpy.types.PropertyGroup):
             "k_max": self.k_max,
             "one_to_one": self.one_to_one if one_to_one is None else one_to_one,
             "placement": self.placement,
+            "partial": self.partial,
         }

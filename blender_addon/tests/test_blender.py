@@ -621,6 +621,42 @@ def test_transfer_with_nothing_to_carry_says_so(addon):
         bpy.ops.shapecorr.transfer()
 
 
+def test_transfer_from_a_part_writes_only_what_the_part_covers(addon):
+    """A quadruped with its lower third cut away carries an attribute to the whole one: the
+    vertices the part holds get it, the others keep their own value, and the report and the
+    panel say so. The figures share their vertex order, which gives the truth."""
+    fresh_scene()
+    (va, ta), (vb, tb) = figures(addon, "quadruped", (0, 1))
+    height = va[:, 1]
+    floor = height.min() + (height.max() - height.min()) / 3
+    kept_triangles = ta[(height[ta] > floor).all(axis=1)]
+    kept = np.unique(kept_triangles)
+    new_index = np.full(len(va), -1, dtype=np.int64)
+    new_index[kept] = np.arange(len(kept))
+    a = add_object("Part", va[kept], new_index[kept_triangles])
+    b = add_object("Whole", vb, tb, location=(3.0, 0.0, 0.0))
+    a.data.attributes.new("heat", "FLOAT", "POINT").data.foreach_set("value", np.ones(len(kept), dtype=np.float32))
+    b.data.attributes.new("heat", "FLOAT", "POINT").data.foreach_set("value", np.full(len(vb), -1.0, dtype=np.float32))
+    select(a, b)
+    settings = bpy.context.scene.shapecorr
+    settings.partial = "a_in_b"
+    try:
+        assert bpy.ops.shapecorr.transfer() == {"FINISHED"}
+    finally:
+        settings.partial = "auto"
+    heat = np.empty(len(vb), dtype=np.float32)
+    b.data.attributes["heat"].data.foreach_get("value", heat)
+    inside = np.zeros(len(vb), dtype=bool)
+    inside[kept] = True
+    written = np.isclose(heat, 1.0)
+    assert np.isclose(heat[~written], -1.0).all(), "a vertex is either carried or left as it was"
+    assert written[inside].mean() > 0.9
+    assert (~written[~inside]).mean() > 0.75
+    answer = settings.answer
+    assert answer.taken_as == "a_in_b"
+    assert answer.uncovered_target == int((~written).sum()) > 0
+
+
 # ------------------------------------------------------------- Check and correct the answer
 
 

@@ -416,6 +416,35 @@ def test_transfer_function_carries_colours_quality_and_texcoords_like_the_librar
     assert pointwise.confidence is not None
 
 
+def test_transfer_from_a_part_keeps_what_b_has_where_the_part_holds_nothing():
+    """A quadruped with its lower third cut away (A, told it is a part) carries its quality
+    to the whole figure: the vertices A holds get it, the others keep B's own, and the report
+    says how many. The figures share their vertex order, which gives the truth."""
+    whole_a, whole_b = (shapecorr.Shape.figure("quadruped", pose, 3000) for pose in (0, 1))
+    vertices, triangles = whole_a.vertices, whole_a.triangles
+    height = vertices[:, 1]
+    floor = height.min() + (height.max() - height.min()) / 3
+    kept_triangles = triangles[(height[triangles] > floor).all(axis=1)]
+    kept = np.unique(kept_triangles)
+    new_index = np.full(len(vertices), -1, dtype=np.int64)
+    new_index[kept] = np.arange(len(kept))
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices[kept], face_matrix=new_index[kept_triangles].astype(np.int32),
+                               v_scalar_array=np.ones(len(kept))))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=whole_b.vertices, face_matrix=whole_b.triangles.astype(np.int32),
+                               v_scalar_array=np.full(whole_b.n_vertices, -1.0)))
+    out, pointwise = shapecorr_meshlab.transfer(ms, colors=False, texcoords=False, partial="a_in_b")
+    quality = out.mesh(0).vertex_scalar_array()
+    written = np.isclose(quality, 1.0)
+    assert np.isclose(quality[~written], -1.0).all(), "a vertex is either carried or left as it was"
+    inside = np.zeros(whole_b.n_vertices, dtype=bool)
+    inside[kept] = True
+    assert written[inside].mean() > 0.9 and (~written[~inside]).mean() > 0.75
+    lines = shapecorr_meshlab.report(pointwise)
+    assert any(line.startswith("partial: A is a part of B (given)") for line in lines), lines
+    assert any(f"partial: {int((~written).sum())} vertices of B" in line for line in lines), lines
+
+
 def cylinder_wedges(vertices, triangles):
     """A per-wedge UV layout: u the angle about the vertical axis, v the height; a triangle
     across the back takes u + 1 at its corners below 0.5 (the back is a seam)."""

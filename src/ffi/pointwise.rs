@@ -1,6 +1,6 @@
 //! Point-to-point maps between two shapes: `sc_pointwise_map` and the result's accessors.
 
-use std::ffi::{c_char, c_void};
+use std::ffi::{c_char, c_void, CStr};
 
 use super::boundary::{
     boundary, boundary_value, check_out, free_handle, give_handle, handle, input_str, write_output,
@@ -14,6 +14,7 @@ use super::params::{options_or_default, ScParams};
 use super::shape::ScShape;
 use super::verdict::{self, VerdictText};
 use super::{CallbackProgress, ScProgressCallback};
+use crate::maps::partial::Partiality;
 use crate::pipeline::PointwiseCorrespondence;
 
 /// The result of `sc_pointwise_map`: a vertex map from B to A, the functional map from A to
@@ -411,6 +412,73 @@ pub unsafe extern "C" fn sc_pointwise_placement_used(pointwise: *const ScPointwi
         Ok(verdict::placement_used(
             handle(pointwise, "pointwise")?.result.verdict(),
         ))
+    })
+}
+
+/// What the pair was taken to be (docs/partial.md, option `partial`): `"whole"`, `"b_in_a"`
+/// (B is a part of A) or `"a_in_b"`; static, NULL for NULL. `out_given`, when not NULL, is
+/// set to true when the option decided it rather than the measurement.
+///
+/// # Safety
+/// `pointwise` must be NULL or live; `out_given` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_taken_as(
+    pointwise: *const ScPointwise,
+    out_given: *mut bool,
+) -> *const c_char {
+    boundary_value(std::ptr::null(), || {
+        let report = &handle(pointwise, "pointwise")?.result.map.partial;
+        if !out_given.is_null() {
+            *out_given = report.given;
+        }
+        let name: &'static CStr = match report.partiality {
+            Partiality::Whole => c"whole",
+            Partiality::BInA => c"b_in_a",
+            Partiality::AInB => c"a_in_b",
+        };
+        Ok(name.as_ptr())
+    })
+}
+
+/// The share of A's area that has a counterpart on B under the map, in [0, 1] (near 1 for
+/// two whole shapes, the part's share for a part of A); NaN for NULL.
+///
+/// # Safety
+/// `pointwise` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_covered_share(pointwise: *const ScPointwise) -> f64 {
+    boundary_value(f64::NAN, || {
+        Ok(handle(pointwise, "pointwise")?.result.map.coverage.share_a)
+    })
+}
+
+/// Copies one side's coverage mask into `out_covered` of `len` elements
+/// (`sc_pointwise_n_vertices(p, side)` of them, in the caller's vertex order): for
+/// `SC_SIDE_A`, whether B's image covers the vertex; for `SC_SIDE_B`, whether the vertex has
+/// a counterpart on A (every vertex, unless A was taken as a part of B). A transfer from A
+/// to B should write only B's covered vertices (docs/partial.md).
+///
+/// # Safety
+/// `pointwise` must be live; `out_covered` must point to `len` writable elements.
+#[no_mangle]
+pub unsafe extern "C" fn sc_pointwise_covered(
+    pointwise: *const ScPointwise,
+    side: u32,
+    out_covered: *mut bool,
+    len: usize,
+) -> ScStatus {
+    boundary(|| {
+        let coverage = &handle(pointwise, "pointwise")?.result.map.coverage;
+        let mask = match side {
+            SC_SIDE_A => &coverage.a,
+            SC_SIDE_B => &coverage.b,
+            _ => {
+                return Err(Failure::invalid(format!(
+                    "side must be SC_SIDE_A (0) or SC_SIDE_B (1), got {side}"
+                )))
+            }
+        };
+        write_output(out_covered, len, mask, "out_covered")
     })
 }
 

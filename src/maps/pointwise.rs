@@ -19,7 +19,7 @@ use crate::maps::fmap::{
 pub use crate::maps::hypotheses::orientation_score;
 use crate::maps::hypotheses::{self, Decision, HypothesisKind, RegionGroups, Verdict};
 use crate::maps::landmarks::{landmark_error, Landmark};
-use crate::maps::partial::PartialReport;
+use crate::maps::partial::{Coverage, PartialReport};
 use crate::maps::placement::{self, Guidance, Placement};
 use crate::progress::{polled, Cancel, Progress, Stage};
 use crate::regions::RegionMatches;
@@ -216,9 +216,11 @@ pub struct PointwiseMap {
     /// Whether B was taken as a part of A (or A of B), and what was measured
     /// ([`crate::maps::partial`]).
     pub partial: PartialReport,
-    /// For every vertex of A, whether B's image covers it ([`crate::maps::partial::covered`]);
+    /// Which vertices of A and of B have a counterpart ([`crate::maps::partial::coverage`]);
     /// empty until the job sets it.
-    pub covered_a: Vec<bool>,
+    pub coverage: Coverage,
+    /// The same for the runner-up's map (`other_p2p_ba`); None when there is none.
+    pub other_coverage: Option<Coverage>,
 }
 
 impl PointwiseMap {
@@ -397,7 +399,8 @@ impl PointwiseMap {
                 refinement: t.elapsed().as_secs_f64(),
             },
             partial: PartialReport::default(),
-            covered_a: Vec::new(),
+            coverage: Coverage::default(),
+            other_coverage: None,
         })
     }
 }

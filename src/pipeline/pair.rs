@@ -541,10 +541,22 @@ fn on_ready(
         for p2p in std::iter::once(&mut map.p2p_ba).chain(map.other_p2p_ba.as_mut()) {
             pin_landmarks(p2p, &job.params.landmarks);
         }
-        // The mask of the working shapes, again on the input ones when proxies stood in.
+        // The masks of the working shapes, again on the input ones when proxies stood in:
+        // A's from the lifted map, B's from each input vertex's nearest working vertex.
         if a.proxy.is_some() || b.proxy.is_some() {
             let n_b = b.shape.active_vertices().len();
-            map.covered_a = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
+            let on_input = |coverage: &mut partial::Coverage, p2p_ba: &[u32]| {
+                coverage.a = partial::covered(a.shape, a.basis.input_area, p2p_ba, n_b);
+                if let Some(proxy) = b.proxy {
+                    coverage.b = (proxy.location.iter())
+                        .map(|at| coverage.b[at.nearest() as usize])
+                        .collect();
+                }
+            };
+            on_input(&mut map.coverage, &map.p2p_ba);
+            if let (Some(coverage), Some(p2p_ba)) = (&mut map.other_coverage, &map.other_p2p_ba) {
+                on_input(coverage, p2p_ba);
+            }
         }
     }
     let proxies_s = if a.proxy.is_some() || b.proxy.is_some() {

@@ -119,6 +119,10 @@ impl PointwiseCorrespondence {
         let mut other = self.clone();
         other.map.other_p2p_ba = Some(std::mem::replace(&mut other.map.p2p_ba, p2p_ba));
         other.map.fmap_ab = verdict.chosen().fmap_ab.clone();
+        if let Some(coverage) = other.map.other_coverage.take() {
+            other.map.partial.covered_share = coverage.share_a;
+            other.map.other_coverage = Some(std::mem::replace(&mut other.map.coverage, coverage));
+        }
         other.regions.matches_one_to_one = verdict.chosen().one_to_one.clone();
         other.regions.verdict = Some(verdict.clone());
         other.map.verdict = Some(verdict);
@@ -174,23 +178,47 @@ pub fn regions_and_map(
         &guidance,
         progress,
     )?;
+    // A's image in B, when A is a part of B: of the chosen map and of the runner-up's.
+    let mut into_whole = [None, None];
     if let (Some(slope), Refinement::ZoomOut(zoomout)) =
         (guidance.part_slope, &pointwise.refinement)
     {
         // The chosen map grown again from its first eigenfunctions on the slanted diagonal:
         // on the generated lower cuts the quadrupeds' mean error fell from 0.057 to 0.015
         // (docs/partial.md).
-        let (fmap_ab, p2p_ba) = polled(progress, Stage::PointwiseMap, (0.9, 1.0), |cancel| {
+        let (fmap_ab, p2p_ba) = polled(progress, Stage::PointwiseMap, (0.9, 0.95), |cancel| {
             partial::part_map((a.basis, b.basis), &map.p2p_ba, slope, zoomout, cancel)
         })?;
         (map.fmap_ab, map.p2p_ba) = (fmap_ab, p2p_ba);
-        pin_landmarks(&mut map.p2p_ba, &params.landmarks);
+        if partial.partiality == Partiality::AInB {
+            let other_fmap_ab = (map.verdict.as_ref())
+                .and_then(|v| Some(v.scores[v.runner_up()?].fmap_ab.clone()))
+                .filter(|_| map.other_p2p_ba.is_some());
+            let fmaps = std::iter::once(map.fmap_ab.clone()).chain(other_fmap_ab);
+            let maps = polled(progress, Stage::PointwiseMap, (0.95, 1.0), |cancel| {
+                fmaps
+                    .map(|fmap| {
+                        partial::part_into_whole((a, b), fmap.as_ref(), slope, zoomout, cancel)
+                    })
+                    .collect::<Result<Vec<_>>>()
+            })?;
+            for (i, (p2p_ab, p2p_ba)) in maps.into_iter().enumerate() {
+                into_whole[i] = Some(p2p_ab);
+                match i {
+                    0 => map.p2p_ba = p2p_ba,
+                    _ => map.other_p2p_ba = Some(p2p_ba),
+                }
+            }
+        }
+        for p2p in std::iter::once(&mut map.p2p_ba).chain(map.other_p2p_ba.as_mut()) {
+            pin_landmarks(p2p, &params.landmarks);
+        }
     }
-    let n_b = b.shape.active_vertices().len();
-    let covered = partial::covered(a.shape, a.basis.input_area, &map.p2p_ba, n_b);
-    partial.covered_share = partial::covered_share(&a.basis.mass, &covered);
+    map.coverage = partial::coverage(a, b, &map.p2p_ba, into_whole[0].as_deref());
+    map.other_coverage = (map.other_p2p_ba.as_deref())
+        .map(|p2p_ba| partial::coverage(a, b, p2p_ba, into_whole[1].as_deref()));
+    partial.covered_share = map.coverage.share_a;
     map.partial = partial;
-    map.covered_a = covered;
     if let Some(verdict) = &map.verdict {
         regions.matches_one_to_one =
             hypotheses::one_to_one_from_map(regions.matches_view(), &map.p2p_ba, &b.basis.mass);

@@ -1752,6 +1752,36 @@ static void test_landmarks_and_other_answer(void) {
     /* Its own other answer exists too (the first one, usually), a handle of its own. */
     CHECK_STATUS(sc_pointwise_other_answer(other, &back), SC_STATUS_OK);
 
+    /* Two whole figures: taken as whole by the measurement; B's image covers nearly all of
+     * A, and every vertex of B has a counterpart; the other answer has its own A mask. */
+    {
+        size_t na = sc_pointwise_n_vertices(p, SC_SIDE_A), covered = 0;
+        bool given = true, *mask = malloc((na > nb ? na : nb) * sizeof *mask);
+        double share = sc_pointwise_covered_share(p);
+        const char *taken_as = sc_pointwise_taken_as(p, &given);
+        CHECK(taken_as != NULL && strcmp(taken_as, "whole") == 0 && !given, "taken as %s%s",
+              taken_as ? taken_as : "NULL", given ? " (given)" : "");
+        CHECK(sc_pointwise_taken_as(p, NULL) == taken_as, "static name, out_given optional");
+        CHECK(share > 0.9 && share <= 1.0, "covered share %g", share);
+        if (mask != NULL) {
+            CHECK_STATUS(sc_pointwise_covered(p, SC_SIDE_A, mask, na), SC_STATUS_OK);
+            for (i = 0; i < na; i++)
+                covered += mask[i];
+            CHECK(covered * 10 >= na * 9, "%zu of %zu vertices of A covered", covered, na);
+            CHECK_STATUS(sc_pointwise_covered(p, SC_SIDE_B, mask, nb), SC_STATUS_OK);
+            for (i = 0, covered = 0; i < nb; i++)
+                covered += mask[i];
+            CHECK(covered == nb, "%zu of %zu vertices of B covered", covered, nb);
+            CHECK_STATUS(sc_pointwise_covered(p, SC_SIDE_B, mask, nb - 1),
+                         SC_STATUS_BUFFER_TOO_SMALL);
+            CHECK_STATUS(sc_pointwise_covered(p, 2, mask, nb), SC_STATUS_INVALID_ARGUMENT);
+            CHECK_STATUS(sc_pointwise_covered(p, SC_SIDE_A, NULL, na), SC_STATUS_NULL_ARGUMENT);
+            CHECK_STATUS(sc_pointwise_covered(other, SC_SIDE_A, mask, na), SC_STATUS_OK);
+            CHECK(isfinite(sc_pointwise_covered_share(other)), "the other answer's share");
+        }
+        free(mask);
+    }
+
     /* The region results carry the same verdict and give their own other answer. */
     CHECK_STATUS(sc_pointwise_regions(p, &regions), SC_STATUS_OK);
     if (regions != NULL) {
@@ -1849,6 +1879,8 @@ static void test_landmark_errors(void) {
           "no decision for NULL");
     CHECK(!sc_pointwise_placement_used(NULL) && !sc_correspondence_placement_used(NULL),
           "no placement for NULL");
+    CHECK(sc_pointwise_taken_as(NULL, NULL) == NULL && isnan(sc_pointwise_covered_share(NULL)),
+          "no partiality for NULL");
     CHECK(isnan(sc_pointwise_turn_degrees(NULL, 0)) && isnan(sc_correspondence_turn_degrees(NULL, 0)),
           "no turn for NULL");
     CHECK(isnan(sc_pointwise_hypothesis_cost(NULL, 0)) &&

@@ -1176,6 +1176,41 @@ class PointwiseMap(_Verdict, _Handle):
             out[stage] = value.value
         return out
 
+    @property
+    def taken_as(self) -> Literal["whole", "b_in_a", "a_in_b"]:
+        """What the pair was taken to be (option ``partial``, docs/partial.md): ``"whole"``,
+        ``"b_in_a"`` (B is a part of A) or ``"a_in_b"`` (A is a part of B)."""
+        return lib.sc_pointwise_taken_as(self, None).decode()
+
+    @property
+    def partial_given(self) -> bool:
+        """True when the ``partial`` option decided :attr:`taken_as`, not the measurement."""
+        given = ctypes.c_bool()
+        lib.sc_pointwise_taken_as(self, ctypes.byref(given))
+        return given.value
+
+    @property
+    def covered_share(self) -> float:
+        """The share of A's area that has a counterpart on B, in [0, 1]."""
+        return lib.sc_pointwise_covered_share(self)
+
+    @property
+    def covered_a(self) -> NDArray[np.bool_]:
+        """For every vertex of A, whether B's image covers it (a bool array)."""
+        return _fill(
+            lib.sc_pointwise_covered, self, _lib.SIDE_A, shape=self.n_vertices_a,
+            dtype=np.bool_, ctype=ctypes.c_bool,
+        )
+
+    @property
+    def covered_b(self) -> NDArray[np.bool_]:
+        """For every vertex of B, whether it has a counterpart on A (all of them unless A was
+        taken as a part of B): a transfer from A to B should write only these."""
+        return _fill(
+            lib.sc_pointwise_covered, self, _lib.SIDE_B, shape=self.n_vertices_b,
+            dtype=np.bool_, ctype=ctypes.c_bool,
+        )
+
     def other_answer(self) -> PointwiseMap | None:
         """The other answer: a new :class:`PointwiseMap` holding the :attr:`runner_up`'s
         vertex map (every vertex of B), functional map and one-to-one regions, with its

@@ -234,6 +234,9 @@ FUNCTIONS = {
     "sc_pointwise_decided_by": (ctypes.c_char_p, [handle]),
     "sc_pointwise_placement_used": (ctypes.c_bool, [handle]),
     "sc_pointwise_other_answer": (status, [handle, handle_out]),
+    "sc_pointwise_taken_as": (ctypes.c_char_p, [handle, c_boolp]),
+    "sc_pointwise_covered_share": (ctypes.c_double, [handle]),
+    "sc_pointwise_covered": (status, [handle, u32_arg, c_boolp, c_size_t]),
     # transfer
     "sc_surface_map_new": (status, [handle, handle, handle, PROGRESS, ctypes.c_void_p, handle_out]),
     "sc_surface_map_free": (None, [handle]),

@@ -7,7 +7,11 @@
 //! above 0.1; the flip allowed for clouds). Prints a line per pair (error, the share of the
 //! whole's area B keeps, confidence) and a summary per variant: mean, median, worst, failed.
 //!
-//!     cargo run --release -p shapecorr-eval --example partial -- [--vertices N] [--partial auto|off|b_in_a]
+//! With `--part-as-a`, the other way round: A is the rest pose cut (the lower third, or six
+//! holes) and B another pose whole, with `partial = a_in_b`; B's vertices that A holds are
+//! scored on A, and B's coverage mask against the truth.
+//!
+//!     cargo run --release -p shapecorr-eval --example partial -- [--vertices N] [--partial auto|off|b_in_a] [--part-as-a]
 
 use shapecorr::evaluation::pointwise_errors;
 use shapecorr::geodesic::HeatGeodesics;
@@ -40,12 +44,15 @@ fn main() -> shapecorr::Result<()> {
                 )?;
                 params.set_option("partial", value)?;
             }
+            "--part-as-a" => return part_as_a(vertices),
             other => panic!("unknown argument {other}"),
         }
     }
     let mut errors: Vec<Vec<f64>> = vec![Vec::new(); VARIANTS.len()];
     let mut mask_right: Vec<Vec<f64>> = vec![Vec::new(); VARIANTS.len()];
     let mut calls = [0usize; VARIANTS.len()];
+    // Seconds of each pair's whole call (`PointwiseCorrespondence::total`).
+    let mut seconds: Vec<Vec<f64>> = vec![Vec::new(); VARIANTS.len()];
     for kind in [FigureKind::Humanoid, FigureKind::Quadruped] {
         let poses: Vec<usize> = (0..synth::n_poses(kind)).collect();
         let meshes = synth::figure_poses(kind, vertices, Default::default(), &poses)?;
@@ -97,7 +104,7 @@ fn main() -> shapecorr::Result<()> {
                         for &w in &part.whole_vertex {
                             truly_covered[w as usize] = true;
                         }
-                        let mask = &result.map.covered_a;
+                        let mask = &result.map.coverage.a;
                         let right = (mask.iter().zip(&truly_covered))
                             .filter(|(m, t)| m == t)
                             .count() as f64
@@ -105,6 +112,7 @@ fn main() -> shapecorr::Result<()> {
                         mask_right[v].push(right);
                         let report = &result.map.partial;
                         calls[v] += usize::from(report.partiality != Partiality::Whole);
+                        seconds[v].push(result.total);
                         format!(
                             "{error:.4} confidence {} taken as {} (covered {:.2}, boundary \
                              {:.2} {:.2}) mask right {right:.3}",
@@ -132,7 +140,7 @@ fn main() -> shapecorr::Result<()> {
         right.sort_by(f64::total_cmp);
         println!(
             "{variant:>15}: mean {:.4} median {:.4} worst {:.4} failed {}/{}; taken as a part \
-             {}/{}; mask right mean {:.3} worst {:.3}",
+             {}/{}; mask right mean {:.3} worst {:.3}; {:.2} s a pair",
             mean(e),
             e[e.len() / 2],
             e[e.len() - 1],
@@ -142,6 +150,68 @@ fn main() -> shapecorr::Result<()> {
             e.len(),
             mean(right),
             right.first().copied().unwrap_or(f64::NAN),
+            mean(&seconds[v]),
+        );
+    }
+    Ok(())
+}
+
+/// A part of the rest pose as A, another pose whole as B (`partial = a_in_b`): the error of
+/// B's vertices that A holds, and the share of B's vertices its mask gets right.
+fn part_as_a(vertices: usize) -> shapecorr::Result<()> {
+    let params = shapecorr::Params {
+        partial: shapecorr::maps::partial::PartialOption::AInB,
+        ..Default::default()
+    };
+    for variant in ["lower third cut", "holes"] {
+        let (mut errors, mut rights) = (Vec::new(), Vec::new());
+        for kind in [FigureKind::Humanoid, FigureKind::Quadruped] {
+            let poses: Vec<usize> = (0..synth::n_poses(kind)).collect();
+            let meshes = synth::figure_poses(kind, vertices, Default::default(), &poses)?;
+            let part = match variant {
+                "holes" => synth::with_holes(&meshes[0], 6, 0.06, 7),
+                _ => synth::cut_below(&meshes[0], 1.0 / 3.0),
+            };
+            let a = Shape::mesh(part.mesh.vertices.clone(), &part.mesh.triangles)?;
+            let heat = HeatGeodesics::new(&a)?;
+            let truth: Vec<(u32, u32)> = (part.whole_vertex.iter().enumerate())
+                .map(|(i, &w)| (i as u32, w))
+                .collect();
+            for (pose, whole) in meshes.iter().enumerate().skip(1) {
+                let b = Shape::mesh(whole.vertices.clone(), &whole.triangles)?;
+                let result = PointwiseCorrespondence::compute(
+                    &a,
+                    &b,
+                    &params,
+                    &Default::default(),
+                    &mut NoProgress,
+                )?;
+                let map = &result.map.p2p_ba;
+                let error = mean(&pointwise_errors(&heat, a.mesh_area(), &truth, &[map])?[0]);
+                let mut truly = vec![false; b.n_vertices()];
+                for &w in &part.whole_vertex {
+                    truly[w as usize] = true;
+                }
+                let mask = &result.map.coverage.b;
+                let right = (mask.iter().zip(&truly)).filter(|(m, t)| m == t).count() as f64
+                    / b.n_vertices() as f64;
+                println!("{kind} pose {pose} {variant} as A: {error:.4} B's mask right {right:.3}");
+                errors.push(error);
+                rights.push(right);
+            }
+        }
+        errors.sort_by(f64::total_cmp);
+        rights.sort_by(f64::total_cmp);
+        println!(
+            "{variant} as A: mean {:.4} median {:.4} worst {:.4} failed {}/{}; B's mask right \
+             mean {:.3} worst {:.3}",
+            mean(&errors),
+            errors[errors.len() / 2],
+            errors[errors.len() - 1],
+            errors.iter().filter(|&&x| x > FAILED).count(),
+            errors.len(),
+            mean(&rights),
+            rights[0],
         );
     }
     Ok(())

@@ -147,7 +147,8 @@ impl Answer<'_> {
             "covered_share": partial.covered_share,
             "open_boundary": partial.boundary,
             "area_share": partial.area_share,
-            "covered_a": result.map.covered_a.iter().filter(|&&c| c).count(),
+            "covered_a": result.map.coverage.a.iter().filter(|&&c| c).count(),
+            "covered_b": result.map.coverage.b.iter().filter(|&&c| c).count(),
         });
         value["options"] = options_json(self.options, true);
         value["region_times"] = json!(self.pointwise.region_times);

@@ -141,6 +141,15 @@ impl TransferArgs {
             result.total,
             self.out.display()
         )?;
+        let uncovered = result.map.coverage.b.iter().filter(|&&c| !c).count();
+        if uncovered > 0 {
+            outln!(
+                "A was taken as a part of B: {uncovered} of {} vertices of B have no \
+                 counterpart on A; their rows come from the nearest part of A, not from a \
+                 counterpart (docs/partial.md)",
+                shape_b.n_vertices()
+            )?;
+        }
         let params = &options.params;
         let other = if self.other_answer {
             ""

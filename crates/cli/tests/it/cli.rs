@@ -366,6 +366,8 @@ fn p2p_writes_a_valid_accurate_map_for_meshes_and_point_clouds() {
             covered * 10 >= n_a * 9 && covered <= n_a,
             "{name}: {covered} of {n_a}"
         );
+        // A whole B: every vertex has a counterpart.
+        assert_eq!(partial["covered_b"].as_u64(), Some(n_b as u64), "{name}");
         let confidence = check_verdict(&result, &String::from_utf8_lossy(&out.stderr));
         assert!(confidence.is_some(), "{name}: verified by default");
         assert!(String::from_utf8_lossy(&out.stdout).contains("confidence "));
