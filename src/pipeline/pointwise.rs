@@ -14,6 +14,7 @@ use crate::progress::{check, polled, AsStage, Progress, Stage};
 use crate::shape::Shape;
 use crate::spectral::eigen::{EigenParams, Eigenbasis, ShapeBasis};
 use crate::{Error, Result};
+use faer::MatRef;
 
 /// Everything from two shapes: eigenbases, region correspondence, pointwise map.
 #[derive(Debug, Clone)]
@@ -120,7 +121,6 @@ impl PointwiseCorrespondence {
         other.map.other_p2p_ba = Some(std::mem::replace(&mut other.map.p2p_ba, p2p_ba));
         other.map.fmap_ab = verdict.chosen().fmap_ab.clone();
         if let Some(coverage) = other.map.other_coverage.take() {
-            other.map.partial.covered_share = coverage.share_a;
             other.map.other_coverage = Some(std::mem::replace(&mut other.map.coverage, coverage));
         }
         other.regions.matches_one_to_one = verdict.chosen().one_to_one.clone();
@@ -169,7 +169,7 @@ pub fn regions_and_map(
         orientation: pointwise.orientation && params.verify_hypotheses,
         ..pointwise.clone()
     };
-    let (mut partial, guidance) = partiality(a, b, params);
+    let (partial, guidance) = partiality(a, b, params);
     let mut map = PointwiseMap::guided(
         a,
         b,
@@ -179,7 +179,7 @@ pub fn regions_and_map(
         progress,
     )?;
     // A's image in B, when A is a part of B: of the chosen map and of the runner-up's.
-    let mut into_whole = [None, None];
+    let (mut into_whole, mut other_into_whole) = (None, None);
     if let (Some(slope), Refinement::ZoomOut(zoomout)) =
         (guidance.part_slope, &pointwise.refinement)
     {
@@ -187,37 +187,33 @@ pub fn regions_and_map(
         // on the generated lower cuts the quadrupeds' mean error fell from 0.057 to 0.015
         // (docs/partial.md).
         let (fmap_ab, p2p_ba) = polled(progress, Stage::PointwiseMap, (0.9, 0.95), |cancel| {
-            partial::part_map((a.basis, b.basis), &map.p2p_ba, slope, zoomout, cancel)
+            partial::part_map((a, b), &map.p2p_ba, slope, zoomout, cancel)
         })?;
         (map.fmap_ab, map.p2p_ba) = (fmap_ab, p2p_ba);
         if partial.partiality == Partiality::AInB {
             let other_fmap_ab = (map.verdict.as_ref())
-                .and_then(|v| Some(v.scores[v.runner_up()?].fmap_ab.clone()))
+                .and_then(|v| Some(&v.scores[v.runner_up()?].fmap_ab))
                 .filter(|_| map.other_p2p_ba.is_some());
-            let fmaps = std::iter::once(map.fmap_ab.clone()).chain(other_fmap_ab);
-            let maps = polled(progress, Stage::PointwiseMap, (0.95, 1.0), |cancel| {
-                fmaps
-                    .map(|fmap| {
-                        partial::part_into_whole((a, b), fmap.as_ref(), slope, zoomout, cancel)
-                    })
-                    .collect::<Result<Vec<_>>>()
-            })?;
-            for (i, (p2p_ab, p2p_ba)) in maps.into_iter().enumerate() {
-                into_whole[i] = Some(p2p_ab);
-                match i {
-                    0 => map.p2p_ba = p2p_ba,
-                    _ => map.other_p2p_ba = Some(p2p_ba),
+            polled(progress, Stage::PointwiseMap, (0.95, 1.0), |cancel| {
+                let into = |fmap: MatRef<'_, f64>| {
+                    partial::part_into_whole((a, b), fmap, slope, zoomout, cancel)
+                };
+                let (p2p_ab, p2p_ba) = into(map.fmap_ab.as_ref())?;
+                (into_whole, map.p2p_ba) = (Some(p2p_ab), p2p_ba);
+                if let Some(fmap) = other_fmap_ab {
+                    let (p2p_ab, p2p_ba) = into(fmap.as_ref())?;
+                    (other_into_whole, map.other_p2p_ba) = (Some(p2p_ab), Some(p2p_ba));
                 }
-            }
+                Ok(())
+            })?;
         }
         for p2p in std::iter::once(&mut map.p2p_ba).chain(map.other_p2p_ba.as_mut()) {
             pin_landmarks(p2p, &params.landmarks);
         }
     }
-    map.coverage = partial::coverage(a, b, &map.p2p_ba, into_whole[0].as_deref());
+    map.coverage = partial::coverage(a, b, &map.p2p_ba, into_whole.as_deref());
     map.other_coverage = (map.other_p2p_ba.as_deref())
-        .map(|p2p_ba| partial::coverage(a, b, p2p_ba, into_whole[1].as_deref()));
-    partial.covered_share = map.coverage.share_a;
+        .map(|p2p_ba| partial::coverage(a, b, p2p_ba, other_into_whole.as_deref()));
     map.partial = partial;
     if let Some(verdict) = &map.verdict {
         regions.matches_one_to_one =

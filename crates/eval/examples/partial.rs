@@ -120,7 +120,7 @@ fn main() -> shapecorr::Result<()> {
                                 .confidence()
                                 .map_or("-".into(), |c| format!("{c:.2}")),
                             report.partiality.name(),
-                            report.covered_share,
+                            result.map.coverage.share_a,
                             report.boundary[0],
                             report.boundary[1],
                         )

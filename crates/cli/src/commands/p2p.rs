@@ -144,7 +144,7 @@ impl Answer<'_> {
         value["partial"] = json!({
             "taken_as": partial.partiality.name(),
             "given": partial.given,
-            "covered_share": partial.covered_share,
+            "covered_share": result.map.coverage.share_a,
             "open_boundary": partial.boundary,
             "area_share": partial.area_share,
             "covered_a": result.map.coverage.a.iter().filter(|&&c| c).count(),
