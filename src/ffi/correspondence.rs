@@ -426,9 +426,9 @@ pub unsafe extern "C" fn sc_correspondence_warning(
 /// The name of a verified hypothesis: `which` is `SC_ANSWER_CHOSEN` (the answer returned) or
 /// `SC_ANSWER_RUNNER_UP` (the cheapest other hypothesis whose map differs, the one
 /// `sc_correspondence_other_answer` gives). Names: `"answer"`, `"mirror"`, `"symmetric"`,
-/// `"alternative G.O"`, `"placement"` (docs/placement.md). NULL when the answer was not
-/// verified (`sc_correspondence_confidence` is NaN), when there is no runner-up, and for
-/// NULL or a bad `which`. The string belongs to `correspondence`: valid until it is freed.
+/// `"alternative G.O"`, `"placement"`, `"landmarks"` (docs/placement.md). NULL when the answer
+/// was not verified (`sc_correspondence_confidence` is NaN), when there is no runner-up, and
+/// for NULL or a bad `which`. The string belongs to `correspondence`: valid until it is freed.
 ///
 /// # Safety
 /// `correspondence` must be NULL or live.

@@ -42,11 +42,14 @@ pub enum HypothesisKind {
     /// The map the shapes' placement gives ([`crate::maps::placement::nearest_in_frame`]),
     /// no region constraint.
     Placement,
+    /// The map the landmarks' distance functions and the point descriptors give, no region
+    /// constraint: right where every region answer is wrong (docs/placement.md, "Landmarks").
+    Landmarks,
 }
 
 impl HypothesisKind {
     /// A short name: `answer`, `mirror`, `symmetric`, `alternative G.O` (group G's option O),
-    /// `placement`.
+    /// `placement`, `landmarks`.
     pub fn name(&self) -> String {
         match self {
             HypothesisKind::Answer => "answer".into(),
@@ -54,6 +57,7 @@ impl HypothesisKind {
             HypothesisKind::Symmetric => "symmetric".into(),
             HypothesisKind::Alternative(g, o) => format!("alternative {g}.{o}"),
             HypothesisKind::Placement => "placement".into(),
+            HypothesisKind::Landmarks => "landmarks".into(),
         }
     }
 }

@@ -286,29 +286,12 @@ impl PointwiseMap {
         } else {
             None
         };
-        let kinds_and_groups: Vec<(HypothesisKind, RegionGroups)> = match regions {
-            // Regions verified already: their answer is the only hypothesis.
-            Some(regions) if params.regions == RegionConstraints::OneToOne && !regions.verified => {
-                let is_cloud = |s: &Shape| s.kind() == ShapeKind::PointCloud;
-                let with_mirror =
-                    params.orientation && (faces.is_some() || is_cloud(a) || is_cloud(b));
-                if params.hypotheses {
-                    hypotheses::candidates(side_a, side_b, regions, with_mirror)
-                } else if with_mirror {
-                    hypotheses::candidates(side_a, side_b, regions, true)
-                        .into_iter()
-                        .filter(|(kind, _)| {
-                            matches!(kind, HypothesisKind::Answer | HypothesisKind::Mirror)
-                        })
-                        .collect()
-                } else {
-                    vec![(HypothesisKind::Answer, groups)]
-                }
-            }
-            _ => vec![(HypothesisKind::Answer, groups)],
-        };
-        let (mut kinds, candidates): (Vec<HypothesisKind>, Vec<RegionGroups>) =
-            kinds_and_groups.into_iter().unzip();
+        let (mut kinds, candidates) = hypotheses_to_verify(
+            (side_a, side_b, faces.is_some()),
+            (regions, groups),
+            params,
+            guidance,
+        );
         let candidate_refs: Vec<&[(Vec<u32>, Vec<u32>)]> =
             candidates.iter().map(Vec::as_slice).collect();
         let orientation_faces = faces
@@ -403,6 +386,46 @@ impl PointwiseMap {
             other_coverage: None,
         })
     }
+}
+
+/// The hypotheses the map is solved for, with their region groups: the region answer's
+/// ([`hypotheses::candidates`]; only the answer when the regions were verified already or
+/// not one-to-one), and with landmarks the landmarks' own, which has no region group.
+fn hypotheses_to_verify(
+    (side_a, side_b, oriented): (ShapeBasis<'_>, ShapeBasis<'_>, bool),
+    (regions, groups): (Option<RegionMatches<'_>>, RegionGroups),
+    params: &PointwiseParams,
+    guidance: &Guidance,
+) -> (Vec<HypothesisKind>, Vec<RegionGroups>) {
+    let kinds_and_groups: Vec<(HypothesisKind, RegionGroups)> = match regions {
+        // Regions verified already: their answer is the only hypothesis.
+        Some(regions) if params.regions == RegionConstraints::OneToOne && !regions.verified => {
+            let is_cloud = |s: &Shape| s.kind() == ShapeKind::PointCloud;
+            let with_mirror = params.orientation
+                && (oriented || is_cloud(side_a.shape) || is_cloud(side_b.shape));
+            if params.hypotheses {
+                hypotheses::candidates(side_a, side_b, regions, with_mirror)
+            } else if with_mirror {
+                hypotheses::candidates(side_a, side_b, regions, true)
+                    .into_iter()
+                    .filter(|(kind, _)| {
+                        matches!(kind, HypothesisKind::Answer | HypothesisKind::Mirror)
+                    })
+                    .collect()
+            } else {
+                vec![(HypothesisKind::Answer, groups)]
+            }
+        }
+        _ => vec![(HypothesisKind::Answer, groups)],
+    };
+    let (mut kinds, mut candidates): (Vec<HypothesisKind>, Vec<RegionGroups>) =
+        kinds_and_groups.into_iter().unzip();
+    // Hypotheses are verified: the landmarks give one more, free of the region answer.
+    if kinds.len() > 1 && !guidance.landmarks.is_empty() {
+        kinds.push(HypothesisKind::Landmarks);
+        candidates.push(Vec::new());
+    }
+    (kinds, candidates)
 }
 
 /// The slope of the maps' slanted diagonal: the guidance's for a part refined by ZoomOut
@@ -573,11 +596,13 @@ fn verified(
         );
         score.one_to_one = match (&score.kind, candidates.get(h), regions) {
             (HypothesisKind::Symmetric, _, _) => Vec::new(),
-            (HypothesisKind::Placement, _, Some(regions)) => hypotheses::one_to_one_from_samples(
-                regions,
-                (Some(&s.sample_b.vertices), &s.sample_b.weights),
-                &s.p2p_ba,
-            ),
+            (HypothesisKind::Placement | HypothesisKind::Landmarks, _, Some(regions)) => {
+                hypotheses::one_to_one_from_samples(
+                    regions,
+                    (Some(&s.sample_b.vertices), &s.sample_b.weights),
+                    &s.p2p_ba,
+                )
+            }
             (_, Some(groups), _) => groups
                 .iter()
                 .filter_map(|(ga, gb)| Some((*ga.first()?, *gb.first()?)))

@@ -61,11 +61,22 @@ fn map_of(
     bb: &Eigenbasis,
     r: &Correspondence,
 ) -> PointwiseMap {
-    PointwiseMap::from_bases(
+    guided_map((a, ba), (b, bb), r, &Guidance::default())
+}
+
+/// The map on the regions `r` with what the user knows (`guidance`).
+fn guided_map(
+    (a, ba): (&Shape, &Eigenbasis),
+    (b, bb): (&Shape, &Eigenbasis),
+    r: &Correspondence,
+    guidance: &Guidance,
+) -> PointwiseMap {
+    PointwiseMap::guided(
         ShapeBasis::new(a, ba),
         ShapeBasis::new(b, bb),
-        Some(r).map(|r| r.matches_view()),
+        Some(r.matches_view()),
         &PointwiseParams::default(),
+        guidance,
         &mut NoProgress,
     )
     .unwrap()
@@ -77,6 +88,40 @@ fn error(a: &Shape, area_a: f64, n_b: usize, p2p_ba: &[u32], truth: &dyn Fn(u32)
     let heat = HeatGeodesics::new(a).unwrap();
     let pairs: Vec<(u32, u32)> = (0..n_b as u32).step_by(3).map(|v| (truth(v), v)).collect();
     ErrorSummary::of(&pointwise_errors(&heat, area_a, &pairs, &[p2p_ba]).unwrap()[0]).mean
+}
+
+/// The generated humanoid at rest (A) and in pose 3 (B), 3,000 vertices each, one vertex
+/// order (so `(v, v)` is the truth), with the pipeline's regions and map.
+struct HumanoidPair {
+    poses: Vec<FigureMesh>,
+    /// A's vertex mirror images ([`synth::mirror_map`]).
+    mirror: Vec<u32>,
+    a: Shape,
+    b: Shape,
+    basis_a: Eigenbasis,
+    basis_b: Eigenbasis,
+    regions: Correspondence,
+    map: PointwiseMap,
+}
+
+impl HumanoidPair {
+    fn rest_and_pose_3() -> HumanoidPair {
+        let poses = meshes(FigureKind::Humanoid, 3000, Proportions::default(), &[0, 3]);
+        let mirror = synth::mirror_map(&poses[0]);
+        let (a, b) = (shape(&poses[0]), shape(&poses[1]));
+        let (basis_a, basis_b) = (basis(&a), basis(&b));
+        let (regions, map) = regions_and_map((&a, &basis_a), (&b, &basis_b), &Params::default());
+        HumanoidPair {
+            poses,
+            mirror,
+            a,
+            b,
+            basis_a,
+            basis_b,
+            regions,
+            map,
+        }
+    }
 }
 
 /// The one-to-one matches with A's side replaced by its mirror image: region `i` of A
@@ -122,15 +167,7 @@ fn a_clouds_mirror_image_answer_is_undone_where_the_shapes_stand_alike() {
         placement: Placement::Trust,
         ..Default::default()
     };
-    let map = PointwiseMap::guided(
-        ShapeBasis::new(&a, &basis_a),
-        ShapeBasis::new(&b, &basis_b),
-        Some(forced.matches_view()),
-        &PointwiseParams::default(),
-        &guidance,
-        &mut NoProgress,
-    )
-    .unwrap();
+    let map = guided_map((&a, &basis_a), (&b, &basis_b), &forced, &guidance);
     let verdict = map.verdict.as_ref().unwrap();
     let kinds: Vec<&HypothesisKind> = verdict.scores.iter().map(|s| &s.kind).collect();
     assert!(
@@ -145,13 +182,89 @@ fn a_clouds_mirror_image_answer_is_undone_where_the_shapes_stand_alike() {
     assert!(err < 0.05, "error without the flip {err}");
 }
 
+/// Where every region answer is wrong (as on TOSCA_r david10 -> david6, docs/placement.md,
+/// "Landmarks"), two landmarks still give the right map: their own hypothesis, free of the
+/// region answer. The regions of B are garbled (each match moved to the next region of B),
+/// so the answer and every hypothesis built from it are wrong.
+#[test]
+fn two_landmarks_give_the_right_map_when_every_region_answer_is_wrong() {
+    let HumanoidPair {
+        poses,
+        mirror,
+        a,
+        b,
+        basis_a,
+        basis_b,
+        regions,
+        ..
+    } = HumanoidPair::rest_and_pose_3();
+    let n_b = regions.graph_b.n_nodes() as u32;
+    let garbled = |matches: &[(u32, u32)]| {
+        let mut moved: Vec<(u32, u32)> = matches.iter().map(|&(i, j)| (i, (j + 1) % n_b)).collect();
+        moved.sort_unstable();
+        moved
+    };
+    let mut forced = regions.clone();
+    forced.matches = garbled(&regions.matches);
+    forced.matches_one_to_one = garbled(&regions.matches_one_to_one);
+    forced.verdict = None;
+    // Two vertices away from the plane of symmetry (one vertex order across poses: (v, v)
+    // are true pairs): the one farthest from its mirror image, then the one farthest from
+    // it and its mirror image.
+    let p = &poses[0].vertices;
+    let apart = |u: usize, v: usize| -> f64 { (0..3).map(|c| (p[u][c] - p[v][c]).powi(2)).sum() };
+    let first = (0..p.len())
+        .max_by(|&u, &v| apart(u, mirror[u] as usize).total_cmp(&apart(v, mirror[v] as usize)))
+        .unwrap();
+    let second = (0..p.len())
+        .max_by(|&u, &v| {
+            let far = |w| apart(w, first).min(apart(w, mirror[first] as usize));
+            far(u).total_cmp(&far(v))
+        })
+        .unwrap();
+    let landmarks = vec![[first as u32; 2], [second as u32; 2]];
+    let map_with = |landmarks: Vec<[u32; 2]>| {
+        let guidance = Guidance {
+            placement: Placement::Ignore,
+            landmarks,
+            ..Default::default()
+        };
+        guided_map((&a, &basis_a), (&b, &basis_b), &forced, &guidance)
+    };
+    let err =
+        |map: &PointwiseMap| error(&a, basis_a.input_area, b.n_vertices(), &map.p2p_ba, &|v| v);
+    let (without, with) = (map_with(Vec::new()), map_with(landmarks.clone()));
+    let verdict = with.verdict.as_ref().unwrap();
+    println!(
+        "humanoid 0 -> 3, garbled regions: without landmarks {:.4}, with two {:.4} ({:?})",
+        err(&without),
+        err(&with),
+        verdict.chosen().kind
+    );
+    assert!(
+        err(&without) > 0.1,
+        "the garbled regions were not wrong: {}",
+        err(&without)
+    );
+    assert_eq!(verdict.chosen().kind, HypothesisKind::Landmarks);
+    assert!(err(&with) < 0.05, "error with two landmarks {}", err(&with));
+    for [la, lb] in landmarks {
+        assert_eq!(with.p2p_ba[lb as usize], la, "landmark {lb} not pinned");
+    }
+}
+
 #[test]
 fn a_forced_mirror_image_answer_gives_the_same_map() {
-    let poses = meshes(FigureKind::Humanoid, 3000, Proportions::default(), &[0, 3]);
-    let mirror = synth::mirror_map(&poses[0]);
-    let (a, b) = (shape(&poses[0]), shape(&poses[1]));
-    let (basis_a, basis_b) = (basis(&a), basis(&b));
-    let (regions, map) = regions_and_map((&a, &basis_a), (&b, &basis_b), &Params::default());
+    let HumanoidPair {
+        mirror,
+        a,
+        b,
+        basis_a,
+        basis_b,
+        regions,
+        map,
+        ..
+    } = HumanoidPair::rest_and_pose_3();
     let unforced = error(&a, basis_a.input_area, b.n_vertices(), &map.p2p_ba, &|v| v);
     // The same regions with the one-to-one answer forced to its mirror image: the map
     // verifies it as it verifies any answer.

@@ -799,7 +799,8 @@ class Hypothesis(NamedTuple):
     """A verified hypothesis of a result (:attr:`Correspondence.runner_up`,
     :attr:`Correspondence.chosen`): its name, cost and the turn its map implies."""
 
-    #: ``"answer"``, ``"mirror"``, ``"symmetric"``, ``"alternative G.O"`` or ``"placement"``.
+    #: ``"answer"``, ``"mirror"``, ``"symmetric"``, ``"alternative G.O"``, ``"placement"`` or
+    #: ``"landmarks"``.
     hypothesis: str
     #: The cost the hypotheses are ranked by (lower is better).
     cost: float
@@ -881,7 +882,8 @@ class _Verdict:
     @property
     def hypothesis(self) -> str | None:
         """The chosen hypothesis's name (``"answer"``, ``"mirror"``, ``"symmetric"``,
-        ``"alternative G.O"``, ``"placement"``), or None when the answer was not verified."""
+        ``"alternative G.O"``, ``"placement"``, ``"landmarks"``), or None when the answer was
+        not verified."""
         chosen = self.chosen
         return None if chosen is None else chosen.hypothesis
 
