@@ -954,9 +954,20 @@ fn sample_orientation(
 /// taken as [`Shape::oriented_triangles`]; `None` when either shape is not orientable (a
 /// cloud whose orientation is not trusted), or no triangle maps to a proper triangle.
 pub fn orientation_score(a: &Shape, b: &Shape, p2p_ba: &[u32]) -> Option<f64> {
+    orientation_scores(a, b, &[p2p_ba]).remove(0)
+}
+
+/// [`orientation_score`] of each of several maps, with A's normals and both shapes'
+/// oriented triangles computed once.
+pub fn orientation_scores(a: &Shape, b: &Shape, maps_ba: &[&[u32]]) -> Vec<Option<f64>> {
     let va = unit_size_vertices(a);
-    let normals_a = vertex_normals(&va, &a.oriented_triangles()?);
-    orientation_kept((&va, &normals_a), &b.oriented_triangles()?, p2p_ba)
+    let Some((faces_a, faces_b)) = a.oriented_triangles().zip(b.oriented_triangles()) else {
+        return vec![None; maps_ba.len()];
+    };
+    let normals_a = vertex_normals(&va, &faces_a);
+    (maps_ba.iter())
+        .map(|p2p| orientation_kept((&va, &normals_a), &faces_b, p2p))
+        .collect()
 }
 
 /// The shape's vertices, divided by a power of two near its size (exact) when it is far

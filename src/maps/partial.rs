@@ -10,7 +10,7 @@ use crate::maps::fmap::{
     embedding_through, nearest_rows, p2p_to_fmap, sloped_sizes, zoomout_sloped, Sample,
     ZoomOutParams,
 };
-use crate::maps::hypotheses::{orientation_score, DistortionProbe};
+use crate::maps::hypotheses::{orientation_scores, DistortionProbe, MapEnergy};
 use crate::progress::Cancel;
 use crate::shape::neighbors::PointTree;
 use crate::shape::{distance, Shape, ShapeKind};
@@ -274,11 +274,16 @@ pub fn part_map(
         k_end,
         ..zoomout.clone()
     };
+    // Each start's map is the top-left block of the largest start's.
+    let largest = sloped_sizes(
+        PART_MAP_STARTS.iter().max().map_or(1, |&s| s.min(k_end)),
+        slope,
+    );
+    let exact = p2p_to_fmap(p2p_ba, phi_a, phi_b, &basis_b.mass, largest.1, largest.0);
     let grow = |start: usize| {
         let (k_b, k_a) = sloped_sizes(start.min(k_end), slope);
-        let fmap = p2p_to_fmap(p2p_ba, phi_a, phi_b, &basis_b.mass, k_a, k_b);
         zoomout_sloped(
-            fmap.as_ref(),
+            exact.as_ref().submatrix(0, 0, k_b, k_a),
             (
                 (phi_a, basis_a.mass.as_slice()),
                 (phi_b, basis_b.mass.as_slice()),
@@ -292,9 +297,6 @@ pub fn part_map(
         .iter()
         .map(|&start| grow(start))
         .collect::<Result<Vec<_>>>()?;
-    if grown.len() == 1 {
-        return Ok(grown.remove(0));
-    }
     cancel.check()?;
     let samples_b = Sample::random(&basis_b.mass, PROBE_SAMPLES, PROBE_SEED).vertices;
     let probe = DistortionProbe::new(
@@ -304,14 +306,21 @@ pub fn part_map(
         1.0 / basis_b.input_area.sqrt(),
         &samples_b,
     );
-    // The hypotheses' cost without the coverage, which a part does not reach: the
-    // distortion over the square of the orientation kept ([`MapEnergy::cost`]).
-    let cost = |p2p: &[u32]| {
-        let on_samples: Vec<u32> = samples_b.iter().map(|&v| p2p[v as usize]).collect();
-        let kept = orientation_score(a.shape, b.shape, p2p).unwrap_or(1.0);
-        probe.distortion(&on_samples) / kept.max(1e-3).powi(2)
-    };
-    let costs: Vec<f64> = grown.iter().map(|(_, p2p)| cost(p2p)).collect();
+    // The hypotheses' cost with the coverage left at 1: a part does not reach all of A.
+    let maps: Vec<&[u32]> = grown.iter().map(|(_, p2p)| p2p.as_slice()).collect();
+    let kept = orientation_scores(a.shape, b.shape, &maps);
+    let costs: Vec<f64> = (maps.iter().zip(kept))
+        .map(|(p2p, orientation)| {
+            let on_samples: Vec<u32> = samples_b.iter().map(|&v| p2p[v as usize]).collect();
+            MapEnergy {
+                distortion: probe.distortion(&on_samples),
+                coverage: 1.0,
+                orientation,
+                residual: 0.0,
+            }
+            .cost()
+        })
+        .collect();
     let best = (0..grown.len())
         .min_by(|&i, &j| costs[i].total_cmp(&costs[j]))
         .unwrap_or(0);

@@ -1,7 +1,7 @@
 //! The pointwise job: the regions and the point-to-point map of a pair on given eigenbases
 //! (docs/design.md, step 13), and the verification of a region answer by maps (step 12.1).
 
-use crate::maps::fmap::ZoomOutParams;
+use crate::maps::fmap::{p2p_to_fmap, ZoomOutParams};
 use crate::maps::hypotheses::{self, Verdict};
 use crate::maps::partial::{self, PartialReport, Partiality};
 use crate::maps::placement::Guidance;
@@ -199,6 +199,10 @@ pub fn regions_and_map(
                     partial::part_into_whole((a, b), fmap, slope, zoomout, cancel)
                 };
                 let (p2p_ab, p2p_ba) = into(map.fmap_ab.as_ref())?;
+                // The functional map of the map given, not of the one it was remade from.
+                let (k_b, k_a) = (map.fmap_ab.nrows(), map.fmap_ab.ncols());
+                let (phi_a, phi_b) = (a.basis.vectors.as_ref(), b.basis.vectors.as_ref());
+                map.fmap_ab = p2p_to_fmap(&p2p_ba, phi_a, phi_b, &b.basis.mass, k_a, k_b);
                 (into_whole, map.p2p_ba) = (Some(p2p_ab), p2p_ba);
                 if let Some(fmap) = other_fmap_ab {
                     let (p2p_ab, p2p_ba) = into(fmap.as_ref())?;
