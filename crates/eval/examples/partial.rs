@@ -164,7 +164,7 @@ fn part_as_a(vertices: usize) -> shapecorr::Result<()> {
         ..Default::default()
     };
     for variant in ["lower third cut", "holes"] {
-        let (mut errors, mut rights) = (Vec::new(), Vec::new());
+        let (mut errors, mut rights, mut seconds) = (Vec::new(), Vec::new(), Vec::new());
         for kind in [FigureKind::Humanoid, FigureKind::Quadruped] {
             let poses: Vec<usize> = (0..synth::n_poses(kind)).collect();
             let meshes = synth::figure_poses(kind, vertices, Default::default(), &poses)?;
@@ -198,13 +198,14 @@ fn part_as_a(vertices: usize) -> shapecorr::Result<()> {
                 println!("{kind} pose {pose} {variant} as A: {error:.4} B's mask right {right:.3}");
                 errors.push(error);
                 rights.push(right);
+                seconds.push(result.total);
             }
         }
         errors.sort_by(f64::total_cmp);
         rights.sort_by(f64::total_cmp);
         println!(
             "{variant} as A: mean {:.4} median {:.4} worst {:.4} failed {}/{}; B's mask right \
-             mean {:.3} worst {:.3}",
+             mean {:.3} worst {:.3}; {:.2} s a pair",
             mean(&errors),
             errors[errors.len() / 2],
             errors[errors.len() - 1],
@@ -212,6 +213,7 @@ fn part_as_a(vertices: usize) -> shapecorr::Result<()> {
             errors.len(),
             mean(&rights),
             rights[0],
+            mean(&seconds),
         );
     }
     Ok(())
